@@ -1,0 +1,33 @@
+#!/bin/sh
+# install-deps.sh — installs what vbcl needs from Debian's packages, only what is missing.
+# Idempotent: a second run installs nothing. Uses sudo when not root.
+set -eu
+
+PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo \
+libcjson-dev libopenimageio-dev openimageio-tools"
+
+missing=""
+for p in $PACKAGES; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing="$missing $p"
+    fi
+done
+
+if [ -z "$missing" ]; then
+    echo "install-deps: all packages present"
+    exit 0
+fi
+
+if [ "$(id -u)" -eq 0 ]; then
+    SUDO=""
+elif command -v sudo >/dev/null 2>&1; then
+    SUDO="sudo"
+else
+    echo "install-deps: need root (or sudo) to install:$missing" >&2
+    exit 1
+fi
+
+echo "install-deps: installing:$missing"
+$SUDO apt-get update
+# shellcheck disable=SC2086
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends $missing
