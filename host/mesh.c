@@ -1,0 +1,291 @@
+/* mesh.c — indexed triangle mesh storage, transforms, bounds and the closed-surface check. */
+#include "mesh.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void mesh_init(Mesh *m)
+{
+    memset(m, 0, sizeof *m);
+}
+
+void mesh_free(Mesh *m)
+{
+    free(m->verts);
+    free(m->normals);
+    free(m->tris);
+    mesh_init(m);
+}
+
+/* Next capacity for an array that must hold `need` items: doubling from 16, capped so the
+ * byte size of the array (elem bytes per item) and the item count both fit. Returns 0 when
+ * impossible. */
+static uint32_t grow_capacity(uint32_t cap, uint32_t need, size_t elem)
+{
+    uint64_t c = cap < 16 ? 16 : cap;
+    while (c < need) c *= 2;
+    if (c > UINT32_MAX) c = UINT32_MAX;
+    if (c < need || c > SIZE_MAX / elem) return 0;
+    return (uint32_t)c;
+}
+
+/* Makes room for `need` vertices (and normals when present). */
+static int reserve_verts(Mesh *m, uint32_t need)
+{
+    if (need <= m->cap_verts) return 0;
+    uint32_t cap = grow_capacity(m->cap_verts, need, sizeof(vec3));
+    if (!cap) return -1;
+    vec3 *v = realloc(m->verts, (size_t)cap * sizeof *v);
+    if (!v) return -1;
+    m->verts = v;
+    if (m->normals) {
+        vec3 *n = realloc(m->normals, (size_t)cap * sizeof *n);
+        if (!n) return -1; /* verts is merely larger than cap_verts says */
+        m->normals = n;
+    }
+    m->cap_verts = cap;
+    return 0;
+}
+
+uint32_t mesh_add_vertex(Mesh *m, vec3 p)
+{
+    if (m->nverts >= UINT32_MAX - 1 || reserve_verts(m, m->nverts + 1) < 0) return UINT32_MAX;
+    m->verts[m->nverts] = p;
+    if (m->normals) m->normals[m->nverts] = v3(0, 0, 0);
+    return m->nverts++;
+}
+
+int mesh_add_triangle(Mesh *m, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (m->ntris == m->cap_tris) {
+        if (m->ntris >= UINT32_MAX / 3) return -1;
+        uint32_t cap = grow_capacity(m->cap_tris, m->ntris + 1, 3 * sizeof(uint32_t));
+        if (!cap || cap > UINT32_MAX / 3) cap = UINT32_MAX / 3;
+        uint32_t *t = realloc(m->tris, (size_t)cap * 3 * sizeof *t);
+        if (!t) return -1;
+        m->tris = t;
+        m->cap_tris = cap;
+    }
+    uint32_t *t = m->tris + (size_t)m->ntris * 3;
+    t[0] = a;
+    t[1] = b;
+    t[2] = c;
+    m->ntris++;
+    return 0;
+}
+
+int mesh_enable_normals(Mesh *m)
+{
+    if (m->normals) return 0;
+    size_t n = m->cap_verts ? m->cap_verts : 1;
+    m->normals = calloc(n, sizeof *m->normals);
+    return m->normals ? 0 : -1;
+}
+
+/* A vertex that has no normal of its own gets the zero vector (the renderer falls back to
+ * the geometric normal for it). */
+int mesh_append(Mesh *dst, const Mesh *src)
+{
+    if (src->nverts > UINT32_MAX - 1 - dst->nverts) return -1;
+    if (src->normals && mesh_enable_normals(dst) < 0) return -1;
+    uint32_t base = dst->nverts;
+    if (reserve_verts(dst, base + src->nverts) < 0) return -1;
+    if (src->nverts) memcpy(dst->verts + base, src->verts, (size_t)src->nverts * sizeof(vec3));
+    if (dst->normals) {
+        if (src->normals)
+            memcpy(dst->normals + base, src->normals, (size_t)src->nverts * sizeof(vec3));
+        else
+            memset(dst->normals + base, 0, (size_t)src->nverts * sizeof(vec3));
+    }
+    dst->nverts += src->nverts;
+    for (uint32_t i = 0; i < src->ntris; i++) {
+        const uint32_t *t = src->tris + (size_t)i * 3;
+        if (mesh_add_triangle(dst, t[0] + base, t[1] + base, t[2] + base) < 0) return -1;
+    }
+    return 0;
+}
+
+void mesh_transform(Mesh *m, const mat4 *xf)
+{
+    for (uint32_t i = 0; i < m->nverts; i++) m->verts[i] = mat4_apply_point(xf, m->verts[i]);
+    if (m->normals)
+        for (uint32_t i = 0; i < m->nverts; i++) {
+            /* zero normals mean "none" and stay zero */
+            if (v3_dot(m->normals[i], m->normals[i]) > 0.0f)
+                m->normals[i] = mat4_apply_normal(xf, m->normals[i]);
+        }
+    if (mat4_det3(xf) < 0.0)
+        for (uint32_t i = 0; i < m->ntris; i++) {
+            uint32_t *t = m->tris + (size_t)i * 3, s = t[1];
+            t[1] = t[2];
+            t[2] = s;
+        }
+}
+
+void mesh_bounds(const Mesh *m, vec3 *lo, vec3 *hi)
+{
+    *lo = v3(INFINITY, INFINITY, INFINITY);
+    *hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t i = 0; i < m->nverts; i++) {
+        *lo = v3_min(*lo, m->verts[i]);
+        *hi = v3_max(*hi, m->verts[i]);
+    }
+}
+
+/* ---- closed-surface check ---- */
+
+/* Bits of a coordinate with -0 folded onto +0, so equal positions hash equally. */
+static uint32_t float_key(float f)
+{
+    uint32_t u;
+    if (f == 0.0f) f = 0.0f;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static uint64_t hash_position(vec3 p)
+{
+    uint64_t h = float_key(p.x) * 0x9E3779B97F4A7C15ull;
+    h ^= (h >> 29) + float_key(p.y) * 0xBF58476D1CE4E5B9ull;
+    h ^= (h >> 31) + float_key(p.z) * 0x94D049BB133111EBull;
+    return h ^ (h >> 32);
+}
+
+static int same_position(vec3 a, vec3 b)
+{
+    return float_key(a.x) == float_key(b.x) && float_key(a.y) == float_key(b.y) &&
+           float_key(a.z) == float_key(b.z);
+}
+
+/* Fills canon[i] with the smallest index of a vertex at the same position as vertex i. */
+static int weld_positions(const Mesh *m, uint32_t *canon)
+{
+    size_t size = 16;
+    while (size < (size_t)m->nverts * 2) size *= 2;
+    uint32_t *table = malloc(size * sizeof *table);
+    if (!table) return -1;
+    memset(table, 0xff, size * sizeof *table);
+    for (uint32_t i = 0; i < m->nverts; i++) {
+        size_t h = (size_t)hash_position(m->verts[i]) & (size - 1);
+        for (;;) {
+            uint32_t j = table[h];
+            if (j == UINT32_MAX) {
+                table[h] = i;
+                canon[i] = i;
+                break;
+            }
+            if (same_position(m->verts[j], m->verts[i])) {
+                canon[i] = j;
+                break;
+            }
+            h = (h + 1) & (size - 1);
+        }
+    }
+    free(table);
+    return 0;
+}
+
+/* One triangle edge: key is (min << 32 | max) of its welded endpoints; tri_dir is the
+ * triangle index times two plus 1 when the triangle runs the edge from max to min. */
+typedef struct Edge {
+    uint64_t key;
+    uint32_t tri_dir;
+} Edge;
+
+static int compare_edges(const void *pa, const void *pb)
+{
+    const Edge *a = pa, *b = pb;
+    if (a->key != b->key) return a->key < b->key ? -1 : 1;
+    return (a->tri_dir > b->tri_dir) - (a->tri_dir < b->tri_dir);
+}
+
+static void format_edge(char *buf, size_t len, vec3 a, vec3 b)
+{
+    snprintf(buf, len, "(%g, %g, %g)-(%g, %g, %g)", a.x, a.y, a.z, b.x, b.y, b.z);
+}
+
+int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
+{
+    char e[160];
+    if (m->ntris == 0) {
+        snprintf(err, errlen, "no triangles");
+        return -1;
+    }
+    if (m->ntris > (UINT32_MAX >> 1)) {
+        snprintf(err, errlen, "too many triangles to check (%u)", m->ntris);
+        return -1;
+    }
+    int rc = -1;
+    uint32_t *canon = malloc(((size_t)m->nverts + 1) * sizeof *canon);
+    Edge *edges = malloc((size_t)m->ntris * 3 * sizeof *edges);
+    if (!canon || !edges || weld_positions(m, canon) < 0) {
+        snprintf(err, errlen, "out of memory checking the mesh");
+        goto done;
+    }
+    size_t ne = 0;
+    for (uint32_t i = 0; i < m->ntris; i++) {
+        const uint32_t *t = m->tris + (size_t)i * 3;
+        uint32_t w[3];
+        for (int k = 0; k < 3; k++) {
+            if (t[k] >= m->nverts) {
+                snprintf(err, errlen, "triangle %u: vertex index %u out of range (%u vertices)", i,
+                         t[k], m->nverts);
+                goto done;
+            }
+            w[k] = canon[t[k]];
+        }
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+            snprintf(err, errlen, "triangle %u repeats a vertex index (%u, %u, %u)", i, t[0], t[1],
+                     t[2]);
+            goto done;
+        }
+        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) {
+            vec3 a = m->verts[w[0]], b = m->verts[w[1]], c = m->verts[w[2]];
+            snprintf(err, errlen,
+                     "triangle %u has two corners at the same position: (%g, %g, %g), "
+                     "(%g, %g, %g), (%g, %g, %g)",
+                     i, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z);
+            goto done;
+        }
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = w[k], b = w[(k + 1) % 3];
+            Edge *ed = &edges[ne++];
+            ed->key = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+            ed->tri_dir = i * 2 + (a > b);
+        }
+    }
+    qsort(edges, ne, sizeof *edges, compare_edges);
+    for (size_t s = 0; s < ne;) {
+        size_t r = s, fwd = 0;
+        while (r < ne && edges[r].key == edges[s].key) fwd += !(edges[r++].tri_dir & 1);
+        size_t count = r - s, bwd = count - fwd;
+        uint32_t lo = (uint32_t)(edges[s].key >> 32), hi = (uint32_t)edges[s].key;
+        if (count == 2 && fwd == 1) {
+            s = r;
+            continue;
+        }
+        if (count == 1) {
+            int back = edges[s].tri_dir & 1;
+            format_edge(e, sizeof e, m->verts[back ? hi : lo], m->verts[back ? lo : hi]);
+            snprintf(err, errlen, "open edge %s: used by 1 triangle (triangle %u)", e,
+                     edges[s].tri_dir >> 1);
+        } else if (count == 2) {
+            int back = bwd == 2;
+            format_edge(e, sizeof e, m->verts[back ? hi : lo], m->verts[back ? lo : hi]);
+            snprintf(err, errlen,
+                     "edge %s used twice in the same direction (inconsistent orientation; "
+                     "triangles %u and %u)",
+                     e, edges[s].tri_dir >> 1, edges[s + 1].tri_dir >> 1);
+        } else {
+            format_edge(e, sizeof e, m->verts[lo], m->verts[hi]);
+            snprintf(err, errlen, "edge %s used by %zu triangles (non-manifold)", e, count);
+        }
+        goto done;
+    }
+    rc = 0;
+done:
+    free(canon);
+    free(edges);
+    return rc;
+}
