@@ -1,0 +1,403 @@
+/* clu.c — OpenCL host utilities: error names, the first-error record, devices, and
+ * program builds with a binary cache. */
+#include <stdio.h>
+
+#include "clu.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+static char first_error[1024];
+
+const char *clu_error_name(cl_int code)
+{
+    switch (code) {
+#define E(x)                                                                                       \
+    case x:                                                                                        \
+        return #x;
+        E(CL_SUCCESS)
+        E(CL_DEVICE_NOT_FOUND)
+        E(CL_DEVICE_NOT_AVAILABLE)
+        E(CL_COMPILER_NOT_AVAILABLE)
+        E(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+        E(CL_OUT_OF_RESOURCES)
+        E(CL_OUT_OF_HOST_MEMORY)
+        E(CL_PROFILING_INFO_NOT_AVAILABLE)
+        E(CL_MEM_COPY_OVERLAP)
+        E(CL_IMAGE_FORMAT_MISMATCH)
+        E(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+        E(CL_BUILD_PROGRAM_FAILURE)
+        E(CL_MAP_FAILURE)
+        E(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+        E(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+        E(CL_COMPILE_PROGRAM_FAILURE)
+        E(CL_LINKER_NOT_AVAILABLE)
+        E(CL_LINK_PROGRAM_FAILURE)
+        E(CL_DEVICE_PARTITION_FAILED)
+        E(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+        E(CL_INVALID_VALUE)
+        E(CL_INVALID_DEVICE_TYPE)
+        E(CL_INVALID_PLATFORM)
+        E(CL_INVALID_DEVICE)
+        E(CL_INVALID_CONTEXT)
+        E(CL_INVALID_QUEUE_PROPERTIES)
+        E(CL_INVALID_COMMAND_QUEUE)
+        E(CL_INVALID_HOST_PTR)
+        E(CL_INVALID_MEM_OBJECT)
+        E(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+        E(CL_INVALID_IMAGE_SIZE)
+        E(CL_INVALID_SAMPLER)
+        E(CL_INVALID_BINARY)
+        E(CL_INVALID_BUILD_OPTIONS)
+        E(CL_INVALID_PROGRAM)
+        E(CL_INVALID_PROGRAM_EXECUTABLE)
+        E(CL_INVALID_KERNEL_NAME)
+        E(CL_INVALID_KERNEL_DEFINITION)
+        E(CL_INVALID_KERNEL)
+        E(CL_INVALID_ARG_INDEX)
+        E(CL_INVALID_ARG_VALUE)
+        E(CL_INVALID_ARG_SIZE)
+        E(CL_INVALID_KERNEL_ARGS)
+        E(CL_INVALID_WORK_DIMENSION)
+        E(CL_INVALID_WORK_GROUP_SIZE)
+        E(CL_INVALID_WORK_ITEM_SIZE)
+        E(CL_INVALID_GLOBAL_OFFSET)
+        E(CL_INVALID_EVENT_WAIT_LIST)
+        E(CL_INVALID_EVENT)
+        E(CL_INVALID_OPERATION)
+        E(CL_INVALID_GL_OBJECT)
+        E(CL_INVALID_BUFFER_SIZE)
+        E(CL_INVALID_MIP_LEVEL)
+        E(CL_INVALID_GLOBAL_WORK_SIZE)
+        E(CL_INVALID_PROPERTY)
+        E(CL_INVALID_IMAGE_DESCRIPTOR)
+        E(CL_INVALID_COMPILER_OPTIONS)
+        E(CL_INVALID_LINKER_OPTIONS)
+        E(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef E
+    case -1001:
+        return "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL driver installed)";
+    default:
+        return "unknown OpenCL error";
+    }
+}
+
+int clu_fail(cl_int code, const char *call, const char *file, int line)
+{
+    if (!first_error[0])
+        snprintf(first_error, sizeof first_error, "%s failed: %s (%d) at %s:%d", call,
+                 clu_error_name(code), (int)code, file, line);
+    return -1;
+}
+
+const char *clu_error(void)
+{
+    return first_error;
+}
+void clu_error_clear(void)
+{
+    first_error[0] = 0;
+}
+
+double clu_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+double clu_event_ms(cl_event ev)
+{
+    cl_ulong a = 0, b = 0;
+    if (clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_START, sizeof a, &a, NULL) ||
+        clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_END, sizeof b, &b, NULL))
+        return 0.0;
+    return b > a ? (double)(b - a) * 1e-6 : 0.0;
+}
+
+/* All devices of all platforms, in listing order. Returns the count (<= max). */
+static int enumerate(cl_platform_id *plats, cl_device_id *devs, int max)
+{
+    cl_uint np = 0;
+    cl_platform_id pl[16];
+    if (clGetPlatformIDs(16, pl, &np) != CL_SUCCESS) return 0;
+    int n = 0;
+    for (cl_uint i = 0; i < np && i < 16; i++) {
+        cl_uint nd = 0;
+        cl_device_id dv[32];
+        if (clGetDeviceIDs(pl[i], CL_DEVICE_TYPE_ALL, 32, dv, &nd) != CL_SUCCESS) continue;
+        for (cl_uint k = 0; k < nd && k < 32 && n < max; k++) {
+            plats[n] = pl[i];
+            devs[n++] = dv[k];
+        }
+    }
+    return n;
+}
+
+static void full_name(cl_platform_id p, cl_device_id d, char *out, size_t n)
+{
+    char pn[128] = "", dn[128] = "";
+    clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof pn, pn, NULL);
+    clGetDeviceInfo(d, CL_DEVICE_NAME, sizeof dn, dn, NULL);
+    snprintf(out, n, "%s / %s", pn, dn);
+}
+
+int clu_list_devices(FILE *out)
+{
+    cl_platform_id plats[64];
+    cl_device_id devs[64];
+    int n = enumerate(plats, devs, 64);
+    if (n == 0)
+        fprintf(out, "no OpenCL devices found (is an ICD such as pocl-opencl-icd installed?)\n");
+    for (int i = 0; i < n; i++) {
+        char name[256], ver[128] = "", cver[128] = "";
+        cl_device_type type = 0;
+        cl_uint cu = 0;
+        cl_ulong mem = 0;
+        full_name(plats[i], devs[i], name, sizeof name);
+        clGetDeviceInfo(devs[i], CL_DEVICE_VERSION, sizeof ver, ver, NULL);
+        clGetDeviceInfo(devs[i], CL_DEVICE_OPENCL_C_VERSION, sizeof cver, cver, NULL);
+        clGetDeviceInfo(devs[i], CL_DEVICE_TYPE, sizeof type, &type, NULL);
+        clGetDeviceInfo(devs[i], CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
+        clGetDeviceInfo(devs[i], CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL);
+        fprintf(out, "%d: %s\n   %s, %s, %s, %u compute units, %.1f GiB\n", i, name,
+                type & CL_DEVICE_TYPE_GPU   ? "GPU"
+                : type & CL_DEVICE_TYPE_CPU ? "CPU"
+                                            : "accelerator",
+                ver, cver, cu, (double)mem / (1024.0 * 1024.0 * 1024.0));
+    }
+    return n;
+}
+
+static int contains_nocase(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; *hay; hay++) {
+        size_t k = 0;
+        while (k < n && hay[k] &&
+               tolower((unsigned char)hay[k]) == tolower((unsigned char)needle[k]))
+            k++;
+        if (k == n) return 1;
+    }
+    return n == 0;
+}
+
+int clu_device_open(const char *spec, VbDevice *d, char *err, size_t errlen)
+{
+    cl_platform_id plats[64];
+    cl_device_id devs[64];
+    memset(d, 0, sizeof *d);
+    int n = enumerate(plats, devs, 64);
+    if (n == 0) {
+        snprintf(err, errlen,
+                 "no OpenCL device found: install an OpenCL driver (make deps "
+                 "installs PoCL) and check with clinfo");
+        return 1;
+    }
+    int pick = -1;
+    if (!spec || !*spec) {
+        pick = 0;
+    } else {
+        char *end;
+        long idx = strtol(spec, &end, 10);
+        if (*end == 0 && end != spec) {
+            if (idx < 0 || idx >= n) {
+                snprintf(err, errlen,
+                         "--device %s: no such device (there are %d; see --list-devices)", spec, n);
+                return 2;
+            }
+            pick = (int)idx;
+        } else {
+            for (int i = 0; i < n && pick < 0; i++) {
+                char name[256];
+                full_name(plats[i], devs[i], name, sizeof name);
+                if (contains_nocase(name, spec)) pick = i;
+            }
+            if (pick < 0) {
+                snprintf(err, errlen,
+                         "--device %s: no device name contains \"%s\" (see --list-devices)", spec,
+                         spec);
+                return 2;
+            }
+        }
+    }
+    d->platform = plats[pick];
+    d->device = devs[pick];
+    full_name(d->platform, d->device, d->name, sizeof d->name);
+    clGetDeviceInfo(d->device, CL_DEVICE_VERSION, sizeof d->version, d->version, NULL);
+    clGetDeviceInfo(d->device, CL_DRIVER_VERSION, sizeof d->driver, d->driver, NULL);
+    clGetDeviceInfo(d->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof d->global_mem, &d->global_mem,
+                    NULL);
+    clGetDeviceInfo(d->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof d->max_alloc, &d->max_alloc,
+                    NULL);
+    clGetDeviceInfo(d->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof d->max_wg, &d->max_wg, NULL);
+    cl_int rc;
+    cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)d->platform, 0};
+    d->context = clCreateContext(props, 1, &d->device, NULL, NULL, &rc);
+    CL_CHECK_ERR(rc, "clCreateContext", fail);
+    d->queue = clCreateCommandQueue(d->context, d->device, CL_QUEUE_PROFILING_ENABLE, &rc);
+    CL_CHECK_ERR(rc, "clCreateCommandQueue", fail_context);
+    return 0;
+fail_context:
+    clReleaseContext(d->context);
+    d->context = NULL;
+fail:
+    snprintf(err, errlen, "%s: %s", d->name, clu_error());
+    return 1;
+}
+
+void clu_device_close(VbDevice *d)
+{
+    if (d->queue) CL_WARN(clReleaseCommandQueue(d->queue));
+    if (d->context) CL_WARN(clReleaseContext(d->context));
+    d->queue = NULL;
+    d->context = NULL;
+}
+
+static uint64_t fnv1a(uint64_t h, const char *s)
+{
+    for (; *s; s++) {
+        h ^= (unsigned char)*s;
+        h *= 1099511628211ull;
+    }
+    return h ^ 0xff;
+}
+
+/* The cache directory, created if needed, or NULL when caching is off or impossible. */
+static const char *cache_dir(char *buf, size_t n)
+{
+    const char *env = getenv("VBCL_CACHE_DIR");
+    if (env && strcmp(env, "off") == 0) return NULL;
+    if (env && *env) {
+        snprintf(buf, n, "%s", env);
+    } else {
+        const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+        if (xdg && *xdg)
+            snprintf(buf, n, "%s/vbcl", xdg);
+        else if (home && *home)
+            snprintf(buf, n, "%s/.cache/vbcl", home);
+        else
+            return NULL;
+    }
+    /* create each component */
+    for (char *p = buf + 1; *p; p++) {
+        if (*p != '/') continue;
+        *p = 0;
+        mkdir(buf, 0755);
+        *p = '/';
+    }
+    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return NULL;
+    return buf;
+}
+
+static unsigned char *read_all(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    unsigned char *buf = NULL;
+    if (fseek(f, 0, SEEK_END) == 0) {
+        long n = ftell(f);
+        if (n > 0 && n < (1L << 30) && fseek(f, 0, SEEK_SET) == 0 && (buf = malloc((size_t)n))) {
+            if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
+                free(buf);
+                buf = NULL;
+            } else {
+                *len = (size_t)n;
+            }
+        }
+    }
+    fclose(f);
+    return buf;
+}
+
+/* Stores the program's binary under path, written whole (temporary file + rename). */
+static void cache_store(cl_program prog, const char *path)
+{
+    size_t size = 0;
+    if (clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, NULL) || !size) return;
+    unsigned char *bin = malloc(size);
+    if (!bin) return;
+    unsigned char *bins[1] = {bin};
+    if (clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins, NULL) == CL_SUCCESS) {
+        char tmp[4200];
+        snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+        FILE *f = fopen(tmp, "wb");
+        if (f) {
+            int ok = fwrite(bin, 1, size, f) == size;
+            ok &= fclose(f) == 0;
+            if (!ok || rename(tmp, path) != 0) remove(tmp);
+        }
+    }
+    free(bin);
+}
+
+static void print_build_log(VbDevice *d, cl_program prog, const char *options)
+{
+    size_t n = 0;
+    clGetProgramBuildInfo(prog, d->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
+    char *log = malloc(n + 1);
+    if (log) {
+        log[0] = 0;
+        clGetProgramBuildInfo(prog, d->device, CL_PROGRAM_BUILD_LOG, n, log, NULL);
+        log[n] = 0;
+        fprintf(stderr, "vbcl: kernel build failed on %s\nbuild options: %s\nbuild log:\n%s\n",
+                d->name, options, log);
+        free(log);
+    }
+}
+
+cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
+                             int *cached)
+{
+    double t0 = clu_now_ms();
+    cl_int rc;
+    cl_program prog = NULL;
+    *cached = 0;
+    char dir[4096], path[4200] = "";
+    if (cache_dir(dir, sizeof dir)) {
+        uint64_t h = 1469598103934665603ull;
+        h = fnv1a(h, source);
+        h = fnv1a(h, options);
+        h = fnv1a(h, d->name);
+        h = fnv1a(h, d->version);
+        h = fnv1a(h, d->driver);
+        snprintf(path, sizeof path, "%s/%016llx.bin", dir, (unsigned long long)h);
+        size_t len = 0;
+        unsigned char *bin = read_all(path, &len);
+        if (bin) {
+            const unsigned char *bins[1] = {bin};
+            cl_int status;
+            prog = clCreateProgramWithBinary(d->context, 1, &d->device, &len, bins, &status, &rc);
+            free(bin);
+            if (prog && rc == CL_SUCCESS && status == CL_SUCCESS &&
+                clBuildProgram(prog, 1, &d->device, options, NULL, NULL) == CL_SUCCESS) {
+                *cached = 1;
+                *ms = clu_now_ms() - t0;
+                return prog;
+            }
+            if (prog) clReleaseProgram(prog);
+            prog = NULL; /* a stale or foreign binary: build from source */
+        }
+    }
+    prog = clCreateProgramWithSource(d->context, 1, &source, NULL, &rc);
+    CL_CHECK_ERR(rc, "clCreateProgramWithSource", fail);
+    rc = clBuildProgram(prog, 1, &d->device, options, NULL, NULL);
+    if (rc != CL_SUCCESS) {
+        print_build_log(d, prog, options);
+        clu_fail(rc, "clBuildProgram", __FILE__, __LINE__);
+        goto fail_program;
+    }
+    if (path[0]) cache_store(prog, path);
+    *ms = clu_now_ms() - t0;
+    return prog;
+fail_program:
+    clReleaseProgram(prog);
+fail:
+    return NULL;
+}

@@ -1,0 +1,84 @@
+/* clu.h — OpenCL host utilities: checked calls, device listing and choice, and program
+ * builds that print the log and options on failure and cache binaries between runs. */
+#ifndef VBCL_CLU_H
+#define VBCL_CLU_H
+
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+#include <stddef.h>
+#include <stdio.h>
+
+/* An OpenCL device with its context and an in-order profiling queue. */
+typedef struct VbDevice {
+    cl_platform_id platform;
+    cl_device_id device;
+    cl_context context;
+    cl_command_queue queue;
+    char name[256];    /* "platform / device" */
+    char version[128]; /* device version */
+    char driver[128];  /* driver version */
+    cl_ulong global_mem, max_alloc;
+    size_t max_wg;
+} VbDevice;
+
+/* The name of an OpenCL error code ("CL_OUT_OF_RESOURCES"). */
+const char *clu_error_name(cl_int code);
+
+/* Records the first failed call (later ones are ignored until clu_error_clear) with the
+ * call text, file, line and the error's name; returns -1 so callers can `return`. */
+int clu_fail(cl_int code, const char *call, const char *file, int line);
+/* The first recorded error message, or "" when none. */
+const char *clu_error(void);
+void clu_error_clear(void);
+
+/* Checks a call that returns cl_int; on failure records it and jumps to label. */
+#define CL_CHECK(call, label)                                                                      \
+    do {                                                                                           \
+        cl_int clu_rc_ = (call);                                                                   \
+        if (clu_rc_ != CL_SUCCESS) {                                                               \
+            clu_fail(clu_rc_, #call, __FILE__, __LINE__);                                          \
+            goto label;                                                                            \
+        }                                                                                          \
+    } while (0)
+
+/* Checks the cl_int error out-parameter of a create call. */
+#define CL_CHECK_ERR(rc, what, label)                                                              \
+    do {                                                                                           \
+        if ((rc) != CL_SUCCESS) {                                                                  \
+            clu_fail((rc), (what), __FILE__, __LINE__);                                            \
+            goto label;                                                                            \
+        }                                                                                          \
+    } while (0)
+
+/* For clean-up paths: warns on stderr instead of recording. */
+#define CL_WARN(call)                                                                              \
+    do {                                                                                           \
+        cl_int clu_rc_ = (call);                                                                   \
+        if (clu_rc_ != CL_SUCCESS)                                                                 \
+            fprintf(stderr, "vbcl: warning: %s failed: %s (%s:%d)\n", #call,                       \
+                    clu_error_name(clu_rc_), __FILE__, __LINE__);                                  \
+    } while (0)
+
+/* Prints every platform and device with its index. Returns the number of devices. */
+int clu_list_devices(FILE *out);
+
+/* Opens the device chosen by spec: an index from clu_list_devices, or a case-insensitive
+ * part of "platform / device"; NULL or "" takes device 0. Returns 0, 2 when spec matches
+ * nothing (usage error), or 1 on an OpenCL failure (clu_error() says which). */
+int clu_device_open(const char *spec, VbDevice *d, char *err, size_t errlen);
+void clu_device_close(VbDevice *d);
+
+/* Builds source with options for d. A binary cache keyed by source, options and device
+ * is used unless VBCL_CACHE_DIR is "off"; *cached says whether it was a cache hit and
+ * *ms the time taken. On a failed build the log and the options are printed to stderr.
+ * Returns the program, or NULL (clu_error() says why). */
+cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
+                             int *cached);
+
+/* Milliseconds between the start and end of a completed, profiled event (0 on error). */
+double clu_event_ms(cl_event ev);
+
+/* Wall-clock milliseconds from a monotonic clock. */
+double clu_now_ms(void);
+
+#endif

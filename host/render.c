@@ -1,0 +1,341 @@
+/* render.c — the host side of a frame: scene to device buffers, the uniform grid, the
+ * kernel program, and the tile loop that enqueues camera rays, closest hits and shading. */
+#include "render.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "kernel_features.h"
+
+/* Fills the camera of the frame from the scene's eye, look_at, up and fov. */
+static void frame_camera(const Scene *s, VbCamera *c)
+{
+    vec3 fwd = v3_norm(v3_sub(s->look_at, s->eye));
+    vec3 right = v3_norm(v3_cross(fwd, s->up));
+    vec3 up = v3_cross(right, fwd);
+    float th = tanf(s->fov * 0.5f * (float)(M_PI / 180.0));
+    float aspect = (float)s->width / (float)s->height;
+    right = v3_scale(right, th * aspect);
+    up = v3_scale(up, th);
+    float *dst[4] = {c->eye, c->forward, c->right, c->up};
+    vec3 src[4] = {s->eye, fwd, right, up};
+    for (int i = 0; i < 4; i++) {
+        dst[i][0] = src[i].x;
+        dst[i][1] = src[i].y;
+        dst[i][2] = src[i].z;
+        dst[i][3] = 0.0f;
+    }
+}
+
+static void frame_grid(const Grid *g, VbGrid *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int i = 0; i < 3; i++) {
+        out->lo[i] = g->lo[i];
+        out->hi[i] = g->hi[i];
+        out->cell[i] = g->cell[i];
+        out->inv_cell[i] = 1.0f / g->cell[i];
+        out->n[i] = g->n[i];
+    }
+}
+
+/* Triangles as the kernels read them, material index in the w of the first vertex. */
+static VbTriangle *pack_triangles(const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    VbTriangle *t = calloc(m->ntris, sizeof *t);
+    if (!t) return NULL;
+    for (uint32_t i = 0; i < m->ntris; i++) {
+        float *dst[3] = {t[i].v0, t[i].v1, t[i].v2};
+        for (int k = 0; k < 3; k++) {
+            vec3 p = m->verts[m->tris[3 * i + k]];
+            dst[k][0] = p.x;
+            dst[k][1] = p.y;
+            dst[k][2] = p.z;
+        }
+        memcpy(&t[i].v0[3], &s->tri_material[i], sizeof(uint32_t));
+    }
+    return t;
+}
+
+static VbTriNormals *pack_normals(const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    VbTriNormals *t = calloc(m->ntris ? m->ntris : 1, sizeof *t);
+    if (!t || !m->normals) return t;
+    for (uint32_t i = 0; i < m->ntris; i++) {
+        float *dst[3] = {t[i].n0, t[i].n1, t[i].n2};
+        for (int k = 0; k < 3; k++) {
+            vec3 n = m->normals[m->tris[3 * i + k]];
+            dst[k][0] = n.x;
+            dst[k][1] = n.y;
+            dst[k][2] = n.z;
+        }
+    }
+    return t;
+}
+
+static cl_mem upload(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags)
+{
+    cl_int rc;
+    /* zero-sized buffers are invalid: keep at least 16 bytes */
+    static const char zeros[16];
+    if (bytes == 0) {
+        bytes = sizeof zeros;
+        data = zeros;
+    }
+    cl_mem m = clCreateBuffer(d->context, flags | (data ? CL_MEM_COPY_HOST_PTR : 0), bytes,
+                              (void *)data, &rc);
+    if (rc != CL_SUCCESS) {
+        clu_fail(rc, "clCreateBuffer", __FILE__, __LINE__);
+        return NULL;
+    }
+    return m;
+}
+
+static int set_args(cl_kernel k, int n, const size_t *sizes, const void *const *vals)
+{
+    for (int i = 0; i < n; i++) {
+        cl_int rc = clSetKernelArg(k, (cl_uint)i, sizes[i], vals[i]);
+        if (rc != CL_SUCCESS) {
+            char what[64];
+            snprintf(what, sizeof what, "clSetKernelArg(argument %d)", i);
+            return clu_fail(rc, what, __FILE__, __LINE__);
+        }
+    }
+    return 0;
+}
+
+int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
+                  RenderStats *st, char *err, size_t errlen)
+{
+    memset(r, 0, sizeof *r);
+    r->dev = dev;
+    clu_error_clear();
+    char gerr[256];
+    const int *res = (s->grid_res[0] > 0) ? s->grid_res : NULL;
+    if (grid_build(&r->grid, &s->mesh, res, s->grid_density, gerr, sizeof gerr)) {
+        snprintf(err, errlen, "%s: grid: %s", s->path, gerr);
+        return 2;
+    }
+    st->grid_ms = r->grid.build_ms;
+
+    r->features = features_of_scene(s);
+    st->features = r->features;
+    features_build_options(r->features, s, extra_options, st->options, sizeof st->options);
+    r->program =
+        clu_program_build(dev, vbcl_kernel_source, st->options, &st->build_ms, &st->build_cached);
+    if (!r->program) goto fail;
+    cl_int rc;
+    r->k_camera = clCreateKernel(r->program, "camera_generate_rays", &rc);
+    CL_CHECK_ERR(rc, "clCreateKernel(camera_generate_rays)", fail);
+    r->k_intersect = clCreateKernel(r->program, "scene_intersect_closest", &rc);
+    CL_CHECK_ERR(rc, "clCreateKernel(scene_intersect_closest)", fail);
+    r->k_shading = clCreateKernel(r->program, "light_sample_shading", &rc);
+    CL_CHECK_ERR(rc, "clCreateKernel(light_sample_shading)", fail);
+
+    double t0 = clu_now_ms();
+    VbTriangle *tris = pack_triangles(s);
+    VbTriNormals *normals = pack_normals(s);
+    if (!tris || !normals) {
+        free(tris);
+        free(normals);
+        snprintf(err, errlen, "out of memory packing %u triangles", s->mesh.ntris);
+        renderer_release(r);
+        return 1;
+    }
+    size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
+    if (nbytes_tris > dev->max_alloc || sizeof(uint32_t) * (size_t)r->grid.nrefs > dev->max_alloc) {
+        free(tris);
+        free(normals);
+        snprintf(err, errlen,
+                 "%s: the scene (%u triangles, %u grid references) does not fit in "
+                 "one allocation on %s (%.0f MiB at most)",
+                 s->path, s->mesh.ntris, r->grid.nrefs, dev->name,
+                 (double)dev->max_alloc / 1048576.0);
+        renderer_release(r);
+        return 2;
+    }
+    r->tris = upload(dev, tris, nbytes_tris, CL_MEM_READ_ONLY);
+    r->normals = upload(
+        dev, normals,
+        (r->features & VBCL_FEATURE_SMOOTH_NORMALS) ? sizeof(VbTriNormals) * s->mesh.ntris : 0,
+        CL_MEM_READ_ONLY);
+    free(tris);
+    free(normals);
+    r->cell_start =
+        upload(dev, r->grid.cell_start, sizeof(uint32_t) * (r->grid.ncells + 1u), CL_MEM_READ_ONLY);
+    r->cell_tris =
+        upload(dev, r->grid.cell_tris, sizeof(uint32_t) * r->grid.nrefs, CL_MEM_READ_ONLY);
+    VbMaterial *mats = calloc((size_t)s->nmaterials, sizeof *mats);
+    if (!mats) goto fail;
+    for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
+    r->materials = upload(dev, mats, sizeof *mats * (size_t)s->nmaterials, CL_MEM_READ_ONLY);
+    free(mats);
+    r->lights = upload(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
+    if (!r->tris || !r->normals || !r->cell_start || !r->cell_tris || !r->materials || !r->lights)
+        goto fail;
+
+    /* frame constants */
+    VbFrame *f = &r->frame_host;
+    memset(f, 0, sizeof *f);
+    frame_camera(s, &f->camera);
+    frame_grid(&r->grid, &f->grid);
+    memcpy(f->background, s->background, sizeof s->background);
+    memcpy(f->ambient, s->ambient, sizeof s->ambient);
+    f->width = s->width;
+    f->height = s->height;
+    f->nlights = (unsigned)s->nlights;
+    f->ntris = s->mesh.ntris;
+    unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
+    f->shadow_strata = strata < 1 ? 1 : strata;
+    f->seed = s->seed;
+    r->frame = upload(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
+
+    /* tiles: bounded so that 32-bit work counters of one tile cannot overflow */
+    long npix = (long)s->width * s->height;
+    long per_pixel = 1 + (long)s->nlights * (long)(f->shadow_strata * f->shadow_strata);
+    long tile = 65536;
+    while (tile > 256 && tile * per_pixel > (1L << 24)) tile /= 2;
+    if (tile > npix) tile = npix;
+    r->tile_pixels = (int)tile;
+    r->rays = upload(dev, NULL, sizeof(VbRay) * (size_t)tile, CL_MEM_READ_WRITE);
+    r->hits = upload(dev, NULL, sizeof(VbHit) * (size_t)tile, CL_MEM_READ_WRITE);
+    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)tile, CL_MEM_WRITE_ONLY);
+    r->counters = upload(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
+    if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->counters) goto fail;
+    st->upload_ms = clu_now_ms() - t0;
+    st->tile_pixels = r->tile_pixels;
+    return 0;
+fail:
+    snprintf(err, errlen, "%s: %s", dev->name, clu_error()[0] ? clu_error() : "out of memory");
+    renderer_release(r);
+    return 1;
+}
+
+static void progress_report(double t_start, long done, long total, int *shown)
+{
+    double el = clu_now_ms() - t_start;
+    if (el < 1000.0 && !*shown) return;
+    double eta = done > 0 ? el * (double)(total - done) / (double)done : 0.0;
+    fprintf(stderr, "\rvbcl: rendering %3.0f%%  (%.1f s elapsed, about %.1f s left) ",
+            100.0 * (double)done / (double)total, el / 1000.0, eta / 1000.0);
+    *shown = 1;
+}
+
+int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
+                    char *err, size_t errlen)
+{
+    VbDevice *d = r->dev;
+    VbFrame *f = &r->frame_host;
+    long npix = (long)s->width * s->height;
+    float *tile_rgba = malloc(sizeof(float) * 4 * (size_t)r->tile_pixels);
+    if (!tile_rgba) {
+        snprintf(err, errlen, "out of memory");
+        return 1;
+    }
+    double t_start = clu_now_ms();
+    int shown = 0;
+    clu_error_clear();
+    for (long first = 0; first < npix; first += r->tile_pixels) {
+        int n = (int)((npix - first) < r->tile_pixels ? (npix - first) : r->tile_pixels);
+        f->first_pixel = (int)first;
+        f->tile_pixels = n;
+        cl_event ev[4] = {0};
+        cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
+        size_t global = ((size_t)n + 63) / 64 * 64;
+        CL_CHECK(clEnqueueWriteBuffer(d->queue, r->frame, CL_FALSE, 0, sizeof *f, f, 0, NULL, NULL),
+                 fail);
+        CL_CHECK(clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0,
+                                      NULL, NULL),
+                 fail);
+        {
+            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem)};
+            const void *v[] = {&r->frame, &r->rays};
+            if (set_args(r->k_camera, 2, sz, v)) goto fail;
+        }
+        CL_CHECK(
+            clEnqueueNDRangeKernel(d->queue, r->k_camera, 1, NULL, &global, NULL, 0, NULL, &ev[0]),
+            fail);
+        {
+            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                                 sizeof(cl_mem), sizeof(cl_int), sizeof(cl_mem), sizeof(cl_mem)};
+            const void *v[] = {&r->frame, &r->tris, &r->cell_start, &r->cell_tris,
+                               &r->rays,  &n,       &r->hits,       &r->counters};
+            if (set_args(r->k_intersect, 8, sz, v)) goto fail;
+        }
+        CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_intersect, 1, NULL, &global, NULL, 0, NULL,
+                                        &ev[1]),
+                 fail);
+        {
+            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                                 sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                                 sizeof(cl_mem), sizeof(cl_int), sizeof(cl_mem), sizeof(cl_mem)};
+            const void *v[] = {
+                &r->frame,     &r->tris,    &r->normals, &r->cell_start, &r->cell_tris,
+                &r->materials, &r->lights,  &r->rays,    &r->hits,       &n,
+                &r->radiance,  &r->counters};
+            if (set_args(r->k_shading, 12, sz, v)) goto fail;
+        }
+        CL_CHECK(
+            clEnqueueNDRangeKernel(d->queue, r->k_shading, 1, NULL, &global, NULL, 0, NULL, &ev[2]),
+            fail);
+        CL_CHECK(clEnqueueReadBuffer(d->queue, r->radiance, CL_FALSE, 0,
+                                     sizeof(float) * 4 * (size_t)n, tile_rgba, 0, NULL, &ev[3]),
+                 fail);
+        CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0,
+                                     NULL, NULL),
+                 fail);
+        st->camera_ms += clu_event_ms(ev[0]);
+        st->intersect_ms += clu_event_ms(ev[1]);
+        st->shading_ms += clu_event_ms(ev[2]);
+        st->readback_ms += clu_event_ms(ev[3]);
+        for (int i = 0; i < 4; i++) clReleaseEvent(ev[i]);
+        memcpy(rgba + 4 * first, tile_rgba, sizeof(float) * 4 * (size_t)n);
+        st->rays_primary += (unsigned long long)n;
+        st->rays_shadow += counts[VBCL_COUNT_SHADOW];
+        st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
+        st->traversal_steps += counts[VBCL_COUNT_TRAVERSAL_STEPS];
+        st->tri_tests += counts[VBCL_COUNT_TRI_TESTS];
+        st->tiles++;
+        if (progress) progress_report(t_start, first + n, npix, &shown);
+        continue;
+    fail:
+        for (int i = 0; i < 4; i++)
+            if (ev[i]) clReleaseEvent(ev[i]);
+        if (shown) fputc('\n', stderr);
+        snprintf(err, errlen, "%s: %s", d->name, clu_error());
+        free(tile_rgba);
+        return 1;
+    }
+    if (shown)
+        fprintf(stderr, "\rvbcl: rendering 100%% (%.1f s)%30s\n", (clu_now_ms() - t_start) / 1000.0,
+                "");
+    st->render_ms = clu_now_ms() - t_start;
+    free(tile_rgba);
+    return 0;
+}
+
+void renderer_release(Renderer *r)
+{
+    cl_mem *mems[] = {&r->tris,      &r->normals,  &r->cell_start, &r->cell_tris,
+                      &r->materials, &r->lights,   &r->frame,      &r->rays,
+                      &r->hits,      &r->radiance, &r->counters};
+    for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
+        if (*mems[i]) {
+            CL_WARN(clReleaseMemObject(*mems[i]));
+            *mems[i] = NULL;
+        }
+    cl_kernel *ks[] = {&r->k_camera, &r->k_intersect, &r->k_shading};
+    for (size_t i = 0; i < 3; i++)
+        if (*ks[i]) {
+            CL_WARN(clReleaseKernel(*ks[i]));
+            *ks[i] = NULL;
+        }
+    if (r->program) CL_WARN(clReleaseProgram(r->program));
+    r->program = NULL;
+    grid_free(&r->grid);
+}

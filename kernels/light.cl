@@ -1,0 +1,168 @@
+#line 2 "light.cl"
+/* light.cl — local shading (thesis 4.1.1, 4.1.4): ambient + diffuse + specular from
+ * spherical lights, with shadow feelers to stratified points on the visible cap. */
+
+/* Integer hash (lowbias32): decorrelated jitter from a pixel, light and stratum. */
+inline uint vb_hash(uint x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+inline float vb_unit_float(uint h)
+{
+    return (float)(h >> 8) * (1.0f / 16777216.0f);
+}
+
+/* Solid angle of the cap of a sphere of radius r seen from distance d > r:
+ * 2 pi (1 - cos theta_max), with sin theta_max = r / d. */
+inline float light_cap_solid_angle(float r, float d)
+{
+    float s2 = (r * r) / (d * d);
+    /* 1 - sqrt(1 - s2) without cancellation for small caps */
+    return 2.0f * VB_PI * s2 / (1.0f + sqrt(fmax(0.0f, 1.0f - s2)));
+}
+
+/* Two unit vectors completing w to an orthonormal frame (Duff et al. 2017). */
+inline void vb_frame(float3 w, float3 *t, float3 *b)
+{
+    float s = copysign(1.0f, w.z);
+    float a = -1.0f / (s + w.z);
+    float c = w.x * w.y * a;
+    *t = (float3)(1.0f + s * w.x * w.x * a, s * c, -s * w.x);
+    *b = (float3)(c, s + w.y * w.y * a, -w.y);
+}
+
+/* A point being shaded, as seen by the ray that found it. */
+typedef struct ShadePoint {
+    float3 p;  /* position */
+    float3 ng; /* unit geometric normal, on the side the ray came from */
+    float3 ns; /* unit shading normal, same side */
+    float3 wo; /* unit direction back along the ray */
+    uint material;
+    uint key; /* decorrelates this point's random jitter */
+} ShadePoint;
+
+/* Counts of one work item's shadow feelers, summed by the caller. */
+typedef struct ShadowCount {
+    uint traced;
+    uint skipped;
+} ShadowCount;
+
+/* Reflected radiance toward wo from one light: the cap of the light sphere visible from
+ * the point is sampled at strata^2 stratified directions; each direction's feeler is
+ * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
+ * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
+inline float3 light_reflect_one(__constant const VbFrame *f, __global const VbTriangle *tris,
+                                __global const uint *cell_start, __global const uint *cell_tris,
+                                __global const VbLight *light, __global const VbMaterial *m,
+                                const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
+{
+    float3 c = vb_gload3(light->centre);
+    float3 radiance = vb_gload3(light->radiance);
+    float r = light->radius;
+    float3 to_c = c - sp->p;
+    float d2 = dot(to_c, to_c);
+    float d = sqrt(d2);
+    float3 kd = vb_gload3(m->diffuse) * (1.0f / VB_PI);
+#ifdef VBCL_HAS_SPECULAR
+    float3 ks = vb_gload3(m->specular);
+    float spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
+#endif
+    float3 origin = ray_offset_origin(sp->p, sp->ng);
+    uint strata = f->shadow_strata;
+
+#ifdef VBCL_HAS_AREA_LIGHTS
+    if (r > 0.0f) {
+        if (d <= r * 1.0001f) { /* inside the light: lit from every direction, no shadow */
+            return radiance * VB_PI * kd;
+        }
+        float3 wc = to_c / d;
+        float sin_max = r / d;
+        if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
+            sc->skipped += strata * strata;
+            return (float3)(0.0f);
+        }
+        float omega = light_cap_solid_angle(r, d);
+        float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
+        float3 tx, ty;
+        vb_frame(wc, &tx, &ty);
+        float3 sum_d = (float3)(0.0f);
+        float sum_cos = 0.0f;
+#ifdef VBCL_HAS_SPECULAR
+        float sum_s = 0.0f;
+#endif
+        for (uint i = 0; i < strata; i++) {
+            for (uint j = 0; j < strata; j++) {
+                uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
+                float u1 = ((float)i + vb_unit_float(h)) / (float)strata;
+                float u2 = ((float)j + vb_unit_float(vb_hash(h))) / (float)strata;
+                float cos_t = 1.0f - u1 * one_minus_cos;
+                float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
+                float phi = 2.0f * VB_PI * u2;
+                float3 w =
+                    normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+                float cos_n = dot(sp->ns, w);
+                if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
+                    sc->skipped++;
+                    continue;
+                }
+                /* distance to the near side of the light sphere along w */
+                float b = dot(w, to_c);
+                float disc = fmax(0.0f, b * b - (d2 - r * r));
+                float t_light = b - sqrt(disc);
+                sc->traced++;
+                if (grid_trace_any(&f->grid, tris, cell_start, cell_tris, origin, w, t_light, tc))
+                    continue;
+                sum_cos += cos_n;
+#ifdef VBCL_HAS_SPECULAR
+                float3 hv = normalize(w + sp->wo);
+                sum_s += pow(fmax(0.0f, dot(sp->ns, hv)), m->exponent) * cos_n;
+#endif
+            }
+        }
+        float scale = omega / (float)(strata * strata);
+        sum_d = kd * (sum_cos * scale);
+#ifdef VBCL_HAS_SPECULAR
+        sum_d += ks * (spec_norm * sum_s * scale);
+#endif
+        return radiance * sum_d;
+    }
+#endif
+    /* a point light: radiance holds the intensity (W/sr) */
+    float3 w = to_c / d;
+    float cos_n = dot(sp->ns, w);
+    if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
+        sc->skipped++;
+        return (float3)(0.0f);
+    }
+    sc->traced++;
+    if (grid_trace_any(&f->grid, tris, cell_start, cell_tris, origin, w, d, tc))
+        return (float3)(0.0f);
+    float3 brdf = kd;
+#ifdef VBCL_HAS_SPECULAR
+    float3 hv = normalize(w + sp->wo);
+    brdf += ks * (spec_norm * pow(fmax(0.0f, dot(sp->ns, hv)), m->exponent));
+#endif
+    return radiance * brdf * (cos_n / d2);
+}
+
+/* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):
+ * k_local * (ambient + sum over lights of diffuse + specular). */
+inline float3 light_shade_local(__constant const VbFrame *f, __global const VbTriangle *tris,
+                                __global const uint *cell_start, __global const uint *cell_tris,
+                                __global const VbMaterial *materials,
+                                __global const VbLight *lights, const ShadePoint *sp,
+                                TraceCount *tc, ShadowCount *sc)
+{
+    __global const VbMaterial *m = materials + sp->material;
+    float3 col = vb_gload3(m->ambient) * vb_cload3(f->ambient);
+    for (uint l = 0; l < f->nlights; l++)
+        col += light_reflect_one(f, tris, cell_start, cell_tris, lights + l, m, sp,
+                                 vb_hash(sp->key * 0x27d4eb2fu + l), tc, sc);
+    return m->k_local * col;
+}
