@@ -1,0 +1,30 @@
+/* image_io.h — the C interface to OpenImageIO: write a linear float RGB image as PNG,
+ * JPEG or TIFF (8-bit sRGB) or EXR (linear float), whole or not at all; read images. */
+#ifndef VBCL_IMAGE_IO_H
+#define VBCL_IMAGE_IO_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Returns 0 when path's extension names a format vbcl writes, else -1 with a message. */
+int image_check_path(const char *path, char *err, size_t errlen);
+
+/* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
+ * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file
+ * is written under a temporary name in the same directory and renamed into place, so an
+ * existing file is replaced only by a complete image. Returns 0, or -1 with a message. */
+int image_write(const char *path, int width, int height, const float *rgba, float exposure,
+                char *err, size_t errlen);
+
+/* Reads an image as floats, 4 channels per pixel (missing channels 0, alpha 1), values as
+ * stored (8-bit images give encoded values in [0, 1]). *rgba is malloc'ed. */
+int image_read(const char *path, int *width, int *height, float **rgba, char *err, size_t errlen);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,302 @@
+/* main.c — the vbcl command line: parse options, load the scene, render, write the
+ * image, report. Only this file exits. */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "clu.h"
+#include "kernel_features.h"
+#include "image_io.h"
+#include "render.h"
+#include "scene.h"
+
+#define VBCL_VERSION "0.1.0"
+
+static const char usage_text[] =
+    "usage: vbcl SCENE.json [options]\n"
+    "       vbcl --list-devices\n"
+    "\n"
+    "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
+    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float).\n"
+    "\n"
+    "options (each overrides the scene's own setting):\n"
+    "  -o, --output FILE        image to write (default: image.output, else SCENE.png)\n"
+    "      --width N            image width in pixels (1..16384)\n"
+    "      --height N           image height in pixels (1..16384)\n"
+    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto)\n"
+    "      --grid-density D     cells per triangle for --grid auto\n"
+    "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
+    "      --exposure STOPS     scale the image by 2^STOPS before writing\n"
+    "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
+    "      --list-devices       list OpenCL platforms and devices with their indices\n"
+    "      --stats              print rays by kind, time per stage and grid statistics\n"
+    "  -q, --quiet              print nothing but errors\n"
+    "  -h, --help               show this help\n"
+    "      --version            show the version\n"
+    "\n"
+    "environment: VBCL_DEVICE (as --device), VBCL_CACHE_DIR (kernel binary cache;\n"
+    "\"off\" disables it; default ~/.cache/vbcl)\n"
+    "exit status: 0 success, 2 bad input or usage, 1 device or render failure\n"
+    "scene format: docs/scene-format.md\n";
+
+/* Command-line settings; a negative or NULL value means "not given". */
+typedef struct Options {
+    const char *scene, *output, *device, *grid;
+    int width, height, shadow_samples;
+    double grid_density, exposure;
+    int have_exposure;
+    int list_devices, stats, quiet;
+} Options;
+
+static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+static int usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "vbcl: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, " (see vbcl --help)\n");
+    va_end(ap);
+    return 2;
+}
+
+static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || errno || v < lo || v > hi) {
+        fprintf(stderr, "vbcl: %s %s: expected a whole number from %d to %d\n", opt, s, lo, hi);
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+static int parse_double(const char *opt, const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
+        fprintf(stderr, "vbcl: %s %s: expected a number from %g to %g\n", opt, s, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* Returns -1 to go on, or an exit status. */
+static int parse_args(int argc, char **argv, Options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = o->height = o->shadow_samples = -1;
+    o->grid_density = -1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
+#define NEEDS_VALUE                                                                                \
+    do {                                                                                           \
+        if (!val) return usage_error("%s needs a value", a);                                       \
+        i++;                                                                                       \
+    } while (0)
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage_text, stdout);
+            return 0;
+        } else if (!strcmp(a, "--version")) {
+            printf("vbcl %s\n", VBCL_VERSION);
+            return 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            NEEDS_VALUE;
+            o->output = val;
+        } else if (!strcmp(a, "--width")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, SCENE_MAX_IMAGE, &o->width)) return 2;
+        } else if (!strcmp(a, "--height")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, SCENE_MAX_IMAGE, &o->height)) return 2;
+        } else if (!strcmp(a, "--grid")) {
+            NEEDS_VALUE;
+            o->grid = val;
+        } else if (!strcmp(a, "--grid-density")) {
+            NEEDS_VALUE;
+            if (parse_double(a, val, 0.01, 64, &o->grid_density)) return 2;
+        } else if (!strcmp(a, "--shadow-samples")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, 1024, &o->shadow_samples)) return 2;
+        } else if (!strcmp(a, "--exposure")) {
+            NEEDS_VALUE;
+            if (parse_double(a, val, -30, 30, &o->exposure)) return 2;
+            o->have_exposure = 1;
+        } else if (!strcmp(a, "--device")) {
+            NEEDS_VALUE;
+            o->device = val;
+        } else if (!strcmp(a, "--list-devices")) {
+            o->list_devices = 1;
+        } else if (!strcmp(a, "--stats")) {
+            o->stats = 1;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            o->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            return usage_error("unknown option %s", a);
+        } else if (o->scene) {
+            return usage_error("one scene at a time (also got %s)", a);
+        } else {
+            o->scene = a;
+        }
+#undef NEEDS_VALUE
+    }
+    if (!o->scene && !o->list_devices) return usage_error("%s", "no scene file given");
+    return -1;
+}
+
+/* The output path: -o, else image.output, else the scene's base name with .png. */
+static char *output_path(const Options *o, const Scene *s)
+{
+    if (o->output) return strdup(o->output);
+    if (s->output) return strdup(s->output);
+    const char *base = strrchr(o->scene, '/');
+    base = base ? base + 1 : o->scene;
+    size_t n = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot) n = (size_t)(dot - base);
+    char *out = malloc(n + 5);
+    if (out) {
+        memcpy(out, base, n);
+        memcpy(out + n, ".png", 5);
+    }
+    return out;
+}
+
+static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, const RenderStats *st,
+                        double write_ms, double total_ms)
+{
+    char feat[128];
+    features_describe(st->features, feat, sizeof feat);
+    unsigned long long rays = st->rays_primary + st->rays_shadow;
+    double kernel_ms = st->camera_ms + st->intersect_ms + st->shading_ms;
+    unsigned strata = r->frame_host.shadow_strata;
+    fprintf(stderr, "scene       %s: %d objects, %u triangles, %d materials, %d lights\n", s->path,
+            s->nobjects, s->mesh.ntris, s->nmaterials, s->nlights);
+    fprintf(stderr, "device      %s (%s)\n", d->name, d->version);
+    fprintf(stderr, "features    %s\n", feat);
+    fprintf(stderr, "program     %.1f ms (%s), options: %s\n", st->build_ms,
+            st->build_cached ? "warm: cached binary" : "cold: built from source", st->options);
+    fprintf(
+        stderr,
+        "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max %u, "
+        "empty %.1f%%\n",
+        r->grid.n[0], r->grid.n[1], r->grid.n[2], r->grid.ncells, s->grid_res[0] ? "given" : "auto",
+        st->grid_ms, r->grid.tris_per_cell_mean, r->grid.tris_per_cell_max,
+        100.0 * r->grid.empty_fraction);
+    fprintf(stderr,
+            "rays        primary %llu, shadow %llu (%u per light per point; %llu skipped: light "
+            "behind the surface), total %llu\n",
+            st->rays_primary, st->rays_shadow, strata * strata, st->shadow_skipped, rays);
+    fprintf(stderr, "work        %.2f cells visited and %.2f triangles tested per ray\n",
+            rays ? (double)st->traversal_steps / (double)rays : 0.0,
+            rays ? (double)st->tri_tests / (double)rays : 0.0);
+    fprintf(stderr, "samples     1.00 per pixel (mean), 1 (max)\n");
+    fprintf(
+        stderr,
+        "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f ms, "
+        "readback %.1f ms (device) | render %.1f ms, write %.1f ms, total %.1f ms (wall)\n",
+        st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->readback_ms,
+        st->render_ms, write_ms, total_ms);
+    fprintf(stderr, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
+            kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
+}
+
+int main(int argc, char **argv)
+{
+    double t0 = clu_now_ms();
+    Options o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc >= 0) return rc;
+    if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
+
+    char err[1024] = "";
+    Scene s;
+    if (scene_load(o.scene, &s, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        return 2;
+    }
+    if (o.width > 0) s.width = o.width;
+    if (o.height > 0) s.height = o.height;
+    if (o.shadow_samples > 0) s.shadow_samples = o.shadow_samples;
+    if (o.grid_density > 0) s.grid_density = (float)o.grid_density;
+    if (o.have_exposure) s.exposure = (float)o.exposure;
+    if (o.grid && scene_parse_grid(o.grid, s.grid_res)) {
+        scene_free(&s);
+        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o.grid);
+    }
+    char *out = output_path(&o, &s);
+    float *rgba = NULL;
+    VbDevice dev = {0};
+    Renderer r = {0};
+    RenderStats st;
+    memset(&st, 0, sizeof st);
+    if (!out) {
+        fprintf(stderr, "vbcl: out of memory\n");
+        rc = 1;
+        goto done_scene;
+    }
+    if (image_check_path(out, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        rc = 2;
+        goto done_scene;
+    }
+    rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
+    if (!rgba) {
+        fprintf(stderr, "vbcl: cannot allocate a %dx%d image\n", s.width, s.height);
+        rc = 1;
+        goto done_scene;
+    }
+    const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
+    rc = clu_device_open(spec, &dev, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        goto done_scene;
+    }
+    rc = renderer_init(&r, &dev, &s, NULL, &st, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        goto done_device;
+    }
+    int progress = !o.quiet && isatty(STDERR_FILENO);
+    if (renderer_render(&r, &s, rgba, &st, progress, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        rc = 1;
+        goto done_renderer;
+    }
+    double tw = clu_now_ms();
+    if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        rc = 1;
+        goto done_renderer;
+    }
+    double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
+    if (o.stats) print_stats(&s, &dev, &r, &st, write_ms, total_ms);
+    if (!o.quiet) {
+        unsigned long long rays = st.rays_primary + st.rays_shadow;
+        printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
+               out, s.width, s.height, total_ms / 1000.0, s.mesh.ntris, rays,
+               st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev.name);
+    }
+    rc = 0;
+done_renderer:
+    renderer_release(&r);
+done_device:
+    clu_device_close(&dev);
+done_scene:
+    free(rgba);
+    free(out);
+    scene_free(&s);
+    return rc;
+}

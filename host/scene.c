@@ -1,0 +1,767 @@
+/* scene.c — loads a JSON scene (cJSON) and turns it into world-space triangles,
+ * checking every value and naming the JSON path of anything wrong. */
+#include "scene.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+
+#include "grid.h"
+
+#define PATH_MAX_LEN 256
+
+/* What a loader needs to report an error: the file and the message buffer. */
+typedef struct Ctx {
+    const char *file;
+    char *err;
+    size_t errlen;
+} Ctx;
+
+static int fail(Ctx *c, const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int fail(Ctx *c, const char *path, const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (path && *path)
+        snprintf(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
+    else
+        snprintf(c->err, c->errlen, "%s: %s", c->file, msg);
+    return -1;
+}
+
+static void path_key(char *out, const char *parent, const char *key)
+{
+    if (parent && *parent)
+        snprintf(out, PATH_MAX_LEN, "%s.%s", parent, key);
+    else
+        snprintf(out, PATH_MAX_LEN, "%s", key);
+}
+
+static void path_index(char *out, const char *parent, int i)
+{
+    snprintf(out, PATH_MAX_LEN, "%s[%d]", parent, i);
+}
+
+static const char *json_type_name(const cJSON *j)
+{
+    if (cJSON_IsNumber(j)) return "a number";
+    if (cJSON_IsString(j)) return "a string";
+    if (cJSON_IsBool(j)) return "a boolean";
+    if (cJSON_IsNull(j)) return "null";
+    if (cJSON_IsArray(j)) return "an array";
+    if (cJSON_IsObject(j)) return "an object";
+    return "an unknown value";
+}
+
+/* Rejects keys not in allowed (NULL-terminated) and keys given twice. */
+static int check_keys(Ctx *c, const cJSON *obj, const char *path, const char *const *allowed)
+{
+    for (const cJSON *k = obj->child; k; k = k->next) {
+        int ok = 0;
+        for (const char *const *a = allowed; *a; a++)
+            if (strcmp(k->string, *a) == 0) ok = 1;
+        char p[PATH_MAX_LEN];
+        path_key(p, path, k->string);
+        if (!ok) {
+            char list[256] = "";
+            for (const char *const *a = allowed; *a; a++) {
+                if (a != allowed) strncat(list, ", ", sizeof list - strlen(list) - 1);
+                strncat(list, *a, sizeof list - strlen(list) - 1);
+            }
+            return fail(c, p, "unknown key (expected one of: %s)", list);
+        }
+        for (const cJSON *o = obj->child; o != k; o = o->next)
+            if (strcmp(o->string, k->string) == 0) return fail(c, p, "key given twice");
+    }
+    return 0;
+}
+
+static int expect_object(Ctx *c, const cJSON *j, const char *path)
+{
+    if (!cJSON_IsObject(j)) return fail(c, path, "expected an object, got %s", json_type_name(j));
+    return 0;
+}
+
+/* Reads obj[key] as a finite number in [lo, hi]; absent: def, or an error if required. */
+static int get_num(Ctx *c, const cJSON *obj, const char *path, const char *key, double lo,
+                   double hi, double def, int required, double *out)
+{
+    char p[PATH_MAX_LEN];
+    path_key(p, path, key);
+    const cJSON *j = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!j) {
+        if (required) return fail(c, p, "missing (expected a number)");
+        *out = def;
+        return 0;
+    }
+    if (!cJSON_IsNumber(j)) return fail(c, p, "expected a number, got %s", json_type_name(j));
+    double v = j->valuedouble;
+    if (!isfinite(v)) return fail(c, p, "expected a finite number");
+    if (v < lo || v > hi) return fail(c, p, "%g is out of range [%g, %g]", v, lo, hi);
+    *out = v;
+    return 0;
+}
+
+static int get_float(Ctx *c, const cJSON *obj, const char *path, const char *key, double lo,
+                     double hi, double def, int required, float *out)
+{
+    double v;
+    if (get_num(c, obj, path, key, lo, hi, def, required, &v)) return -1;
+    *out = (float)v;
+    return 0;
+}
+
+static int get_int(Ctx *c, const cJSON *obj, const char *path, const char *key, int lo, int hi,
+                   int def, int required, int *out)
+{
+    double v;
+    if (get_num(c, obj, path, key, lo, hi, def, required, &v)) return -1;
+    if (v != floor(v)) {
+        char p[PATH_MAX_LEN];
+        path_key(p, path, key);
+        return fail(c, p, "expected a whole number, got %g", v);
+    }
+    *out = (int)v;
+    return 0;
+}
+
+/* Reads an array of n finite numbers in [lo, hi] at j. */
+static int read_vec(Ctx *c, const cJSON *j, const char *p, int n, double lo, double hi, float *out)
+{
+    if (!cJSON_IsArray(j) || cJSON_GetArraySize(j) != n)
+        return fail(c, p, "expected an array of %d numbers, got %s", n,
+                    cJSON_IsArray(j) ? "an array of another length" : json_type_name(j));
+    int i = 0;
+    for (const cJSON *e = j->child; e; e = e->next, i++) {
+        char pi[PATH_MAX_LEN];
+        path_index(pi, p, i);
+        if (!cJSON_IsNumber(e)) return fail(c, pi, "expected a number, got %s", json_type_name(e));
+        if (!isfinite(e->valuedouble)) return fail(c, pi, "expected a finite number");
+        if (e->valuedouble < lo || e->valuedouble > hi)
+            return fail(c, pi, "%g is out of range [%g, %g]", e->valuedouble, lo, hi);
+        out[i] = (float)e->valuedouble;
+    }
+    return 0;
+}
+
+static int get_vec(Ctx *c, const cJSON *obj, const char *path, const char *key, int n, double lo,
+                   double hi, const float *def, float *out)
+{
+    char p[PATH_MAX_LEN];
+    path_key(p, path, key);
+    const cJSON *j = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!j) {
+        if (!def) return fail(c, p, "missing (expected an array of %d numbers)", n);
+        memcpy(out, def, sizeof(float) * (size_t)n);
+        return 0;
+    }
+    return read_vec(c, j, p, n, lo, hi, out);
+}
+
+static int get_vec3(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
+                    vec3 *out)
+{
+    float v[3];
+    if (get_vec(c, obj, path, key, 3, -FLT_MAX, FLT_MAX, def, v)) return -1;
+    *out = v3(v[0], v[1], v[2]);
+    return 0;
+}
+
+/* A colour: [r, g, b], each >= 0. */
+static int get_rgb(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
+                   float *out)
+{
+    return get_vec(c, obj, path, key, 3, 0.0, FLT_MAX, def, out);
+}
+
+static char *dup_string(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+/* Converts the byte offset of a syntax error into line and column (1-based). */
+static void text_position(const char *text, const char *at, int *line, int *col)
+{
+    *line = 1;
+    *col = 1;
+    for (const char *p = text; p < at && *p; p++) {
+        if (*p == '\n') {
+            (*line)++;
+            *col = 1;
+        } else {
+            (*col)++;
+        }
+    }
+}
+
+static int read_file(Ctx *c, const char *path, char **out)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return fail(c, NULL, "cannot open: %s", strerror(errno));
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap + 1);
+    if (!buf) {
+        fclose(f);
+        return fail(c, NULL, "out of memory");
+    }
+    size_t got;
+    while ((got = fread(buf + len, 1, cap - len, f)) > 0) {
+        len += got;
+        if (len == cap) {
+            if (cap > ((size_t)1 << 30)) {
+                free(buf);
+                fclose(f);
+                return fail(c, NULL, "file larger than 1 GiB");
+            }
+            char *nb = realloc(buf, cap * 2 + 1);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return fail(c, NULL, "out of memory");
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return fail(c, NULL, "read error");
+    }
+    buf[len] = 0;
+    if (strlen(buf) != len) {
+        free(buf);
+        return fail(c, NULL, "file contains a NUL byte: not a JSON text file");
+    }
+    *out = buf;
+    return 0;
+}
+
+int scene_parse_grid(const char *text, int res[3])
+{
+    if (strcmp(text, "auto") == 0) {
+        res[0] = res[1] = res[2] = 0;
+        return 0;
+    }
+    long v[3];
+    const char *p = text;
+    int n = 0;
+    while (n < 3) {
+        char *end;
+        errno = 0;
+        v[n] = strtol(p, &end, 10);
+        if (end == p || errno || v[n] < 1 || v[n] > GRID_MAX_AXIS) return -1;
+        n++;
+        if (*end == 0) break;
+        if (*end != ',') return -1;
+        p = end + 1;
+    }
+    if (n == 1)
+        v[1] = v[2] = v[0];
+    else if (n != 3)
+        return -1;
+    for (int i = 0; i < 3; i++) res[i] = (int)v[i];
+    return 0;
+}
+
+static int load_image(Ctx *c, const cJSON *j, Scene *s)
+{
+    static const char *const keys[] = {"width", "height", "output", "exposure", "background", NULL};
+    static const float black[3] = {0, 0, 0};
+    if (expect_object(c, j, "image") || check_keys(c, j, "image", keys)) return -1;
+    if (get_int(c, j, "image", "width", 1, SCENE_MAX_IMAGE, 400, 0, &s->width) ||
+        get_int(c, j, "image", "height", 1, SCENE_MAX_IMAGE, 400, 0, &s->height) ||
+        get_float(c, j, "image", "exposure", -30, 30, 0, 0, &s->exposure) ||
+        get_rgb(c, j, "image", "background", black, s->background))
+        return -1;
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(j, "output");
+    if (o) {
+        if (!cJSON_IsString(o) || !o->valuestring[0])
+            return fail(c, "image.output", "expected a file name, got %s", json_type_name(o));
+        if (!(s->output = dup_string(o->valuestring))) return fail(c, NULL, "out of memory");
+    }
+    return 0;
+}
+
+static int load_camera(Ctx *c, const cJSON *j, Scene *s)
+{
+    static const char *const keys[] = {"eye", "look_at", "up", "fov", NULL};
+    static const float up[3] = {0, 1, 0};
+    if (expect_object(c, j, "camera") || check_keys(c, j, "camera", keys)) return -1;
+    if (get_vec3(c, j, "camera", "eye", NULL, &s->eye) ||
+        get_vec3(c, j, "camera", "look_at", NULL, &s->look_at) ||
+        get_vec3(c, j, "camera", "up", up, &s->up) ||
+        get_float(c, j, "camera", "fov", 0.01, 179, 45, 0, &s->fov))
+        return -1;
+    vec3 fwd = v3_sub(s->look_at, s->eye);
+    if (v3_len(fwd) <= 0.0f) return fail(c, "camera.look_at", "must differ from camera.eye");
+    if (v3_len(v3_cross(fwd, s->up)) <= 1e-6f * v3_len(fwd) * v3_len(s->up))
+        return fail(c, "camera.up", "must not be parallel to the viewing direction");
+    return 0;
+}
+
+static int load_render(Ctx *c, const cJSON *j, Scene *s)
+{
+    static const char *const keys[] = {
+        "max_depth", "grid", "grid_density", "shadow_samples", "ambient", "seed", NULL};
+    static const float amb[3] = {0.1f, 0.1f, 0.1f};
+    s->max_depth = 6;
+    s->grid_density = GRID_DEFAULT_DENSITY;
+    s->shadow_samples = 16;
+    memcpy(s->ambient, amb, sizeof amb);
+    s->seed = 1;
+    if (!j) return 0; /* absent: all defaults */
+    if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
+    int seed;
+    if (get_int(c, j, "render", "max_depth", 1, 64, 6, 0, &s->max_depth) ||
+        get_float(c, j, "render", "grid_density", 0.01, 64, GRID_DEFAULT_DENSITY, 0,
+                  &s->grid_density) ||
+        get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
+        get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
+        get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed))
+        return -1;
+    s->seed = (unsigned)seed;
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(j, "grid");
+    if (g) {
+        if (cJSON_IsString(g)) {
+            if (strcmp(g->valuestring, "auto") != 0)
+                return fail(c, "render.grid", "expected \"auto\", a number or [nx, ny, nz]");
+        } else if (cJSON_IsNumber(g)) {
+            int n;
+            if (get_int(c, j, "render", "grid", 1, GRID_MAX_AXIS, 0, 1, &n)) return -1;
+            s->grid_res[0] = s->grid_res[1] = s->grid_res[2] = n;
+        } else {
+            float v[3];
+            if (read_vec(c, g, "render.grid", 3, 1, GRID_MAX_AXIS, v)) return -1;
+            for (int i = 0; i < 3; i++) {
+                if (v[i] != floorf(v[i]))
+                    return fail(c, "render.grid", "expected whole numbers of cells");
+                s->grid_res[i] = (int)v[i];
+            }
+        }
+    }
+    return 0;
+}
+
+static int load_lights(Ctx *c, const cJSON *j, Scene *s)
+{
+    static const char *const keys[] = {"centre", "radius", "flux", "intensity", "colour", NULL};
+    static const float white[3] = {1, 1, 1};
+    if (!j) return 0;
+    if (!cJSON_IsArray(j)) return fail(c, "lights", "expected an array, got %s", json_type_name(j));
+    int n = cJSON_GetArraySize(j);
+    if (n > 256) return fail(c, "lights", "%d lights: at most 256", n);
+    s->lights = calloc((size_t)(n ? n : 1), sizeof *s->lights);
+    if (!s->lights) return fail(c, NULL, "out of memory");
+    int i = 0;
+    for (const cJSON *e = j->child; e; e = e->next, i++) {
+        char p[PATH_MAX_LEN];
+        path_index(p, "lights", i);
+        if (expect_object(c, e, p) || check_keys(c, e, p, keys)) return -1;
+        vec3 centre;
+        float radius, colour[3];
+        double flux, intensity;
+        if (get_vec3(c, e, p, "centre", NULL, &centre) ||
+            get_float(c, e, p, "radius", 0, FLT_MAX, 0, 0, &radius) ||
+            get_num(c, e, p, "flux", DBL_MIN, FLT_MAX, -1, 0, &flux) ||
+            get_num(c, e, p, "intensity", DBL_MIN, FLT_MAX, -1, 0, &intensity) ||
+            get_rgb(c, e, p, "colour", white, colour))
+            return -1;
+        if ((flux < 0) == (intensity < 0))
+            return fail(c, p, "give exactly one of \"flux\" and \"intensity\"");
+        /* intensity I = flux / 4 pi; a sphere of uniform radiance L has I = L pi r^2 */
+        double I = intensity > 0 ? intensity : flux / (4.0 * M_PI);
+        double scale = radius > 0 ? I / (M_PI * (double)radius * radius) : I;
+        VbLight *l = &s->lights[i];
+        l->centre[0] = centre.x;
+        l->centre[1] = centre.y;
+        l->centre[2] = centre.z;
+        l->radius = radius;
+        for (int k = 0; k < 3; k++) l->radiance[k] = (float)(scale * colour[k]);
+        if (!isfinite(l->radiance[0] + l->radiance[1] + l->radiance[2]))
+            return fail(c, p, "radiance overflows: the light is too bright for its size");
+    }
+    s->nlights = n;
+    return 0;
+}
+
+static int load_materials(Ctx *c, const cJSON *j, Scene *s)
+{
+    static const char *const keys[] = {"ambient",  "diffuse", "specular",   "exponent", "k_local",
+                                       "k_global", "eta",     "extinction", NULL};
+    static const float grey[3] = {0.8f, 0.8f, 0.8f}, black[3] = {0, 0, 0};
+    if (!j) return fail(c, "materials", "missing (expected an object of named materials)");
+    if (expect_object(c, j, "materials")) return -1;
+    int n = cJSON_GetArraySize(j);
+    if (n == 0) return fail(c, "materials", "expected at least one material");
+    if (n > 65535) return fail(c, "materials", "%d materials: at most 65535", n);
+    s->materials = calloc((size_t)n, sizeof *s->materials);
+    if (!s->materials) return fail(c, NULL, "out of memory");
+    int i = 0;
+    for (const cJSON *e = j->child; e; e = e->next, i++) {
+        char p[PATH_MAX_LEN];
+        path_key(p, "materials", e->string);
+        for (const cJSON *o = j->child; o != e; o = o->next)
+            if (strcmp(o->string, e->string) == 0) return fail(c, p, "material defined twice");
+        if (!e->string[0] || strlen(e->string) >= SCENE_NAME_MAX)
+            return fail(c, p, "a material name must have 1 to %d characters", SCENE_NAME_MAX - 1);
+        if (expect_object(c, e, p) || check_keys(c, e, p, keys)) return -1;
+        SceneMaterial *m = &s->materials[i];
+        VbMaterial *g = &m->gpu;
+        snprintf(m->name, sizeof m->name, "%s", e->string);
+        if (get_rgb(c, e, p, "diffuse", grey, g->diffuse) ||
+            get_rgb(c, e, p, "ambient", g->diffuse, g->ambient) ||
+            get_rgb(c, e, p, "specular", black, g->specular) ||
+            get_float(c, e, p, "exponent", 0, 1e5, 32, 0, &g->exponent) ||
+            get_float(c, e, p, "k_local", 0, 1, 1, 0, &g->k_local) ||
+            get_float(c, e, p, "k_global", 0, 1, 0, 0, &g->k_global) ||
+            get_float(c, e, p, "eta", 1e-3, 100, 1, 0, &g->eta))
+            return -1;
+        const cJSON *x = cJSON_GetObjectItemCaseSensitive(e, "extinction");
+        if (x && cJSON_IsNumber(x)) {
+            float a;
+            if (get_float(c, e, p, "extinction", 0, FLT_MAX, 0, 1, &a)) return -1;
+            g->extinction[0] = g->extinction[1] = g->extinction[2] = a;
+        } else if (get_rgb(c, e, p, "extinction", black, g->extinction)) {
+            return -1;
+        }
+    }
+    s->nmaterials = n;
+    return 0;
+}
+
+static int find_material(const Scene *s, const char *name)
+{
+    for (int i = 0; i < s->nmaterials; i++)
+        if (strcmp(s->materials[i].name, name) == 0) return i;
+    return -1;
+}
+
+/* Builds the object-to-world transform: scale, then rotate about x, y, z, then translate. */
+static int load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
+{
+    static const char *const keys[] = {"translate", "rotate", "scale", NULL};
+    static const float zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
+    *xf = mat4_identity();
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(obj, "transform");
+    if (!t) return 0;
+    char p[PATH_MAX_LEN];
+    path_key(p, path, "transform");
+    if (expect_object(c, t, p) || check_keys(c, t, p, keys)) return -1;
+    float tr[3], rot[3], sc[3];
+    if (get_vec(c, t, p, "translate", 3, -FLT_MAX, FLT_MAX, zero, tr) ||
+        get_vec(c, t, p, "rotate", 3, -1e6, 1e6, zero, rot))
+        return -1;
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(t, "scale");
+    if (s && cJSON_IsNumber(s)) {
+        float k;
+        if (get_float(c, t, p, "scale", -FLT_MAX, FLT_MAX, 1, 1, &k)) return -1;
+        sc[0] = sc[1] = sc[2] = k;
+    } else if (get_vec(c, t, p, "scale", 3, -FLT_MAX, FLT_MAX, one, sc)) {
+        return -1;
+    }
+    if (sc[0] == 0 || sc[1] == 0 || sc[2] == 0) {
+        char ps[PATH_MAX_LEN];
+        path_key(ps, p, "scale");
+        return fail(c, ps, "a scale factor of 0 flattens the object");
+    }
+    mat4 m = mat4_scale(v3(sc[0], sc[1], sc[2]));
+    for (int a = 0; a < 3; a++) m = mat4_mul(mat4_rotate_axis(a, rot[a]), m);
+    *xf = mat4_mul(mat4_translate(v3(tr[0], tr[1], tr[2])), m);
+    return 0;
+}
+
+static void join_path(char *out, size_t n, const char *dir, const char *file)
+{
+    if (file[0] == '/' || !dir || !dir[0])
+        snprintf(out, n, "%s", file);
+    else
+        snprintf(out, n, "%s/%s", dir, file);
+}
+
+/* Tessellates one object's shape into m (object space). */
+static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, const Scene *s,
+                      Mesh *m)
+{
+    char q[PATH_MAX_LEN];
+    int rc = 0;
+    if (strcmp(shape, "mesh") == 0) {
+        static const char *const keys[] = {"shape", "material", "name", "transform", "file", NULL};
+        if (check_keys(c, o, p, keys)) return -1;
+        path_key(q, p, "file");
+        const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "file");
+        if (!f) return fail(c, q, "missing (expected a mesh file name)");
+        if (!cJSON_IsString(f) || !f->valuestring[0])
+            return fail(c, q, "expected a file name, got %s", json_type_name(f));
+        char full[4096], merr[512];
+        join_path(full, sizeof full, s->dir, f->valuestring);
+        if (mesh_load(full, m, merr, sizeof merr)) return fail(c, q, "%s", merr);
+        return 0;
+    }
+    if (strcmp(shape, "sphere") == 0) {
+        static const char *const keys[] = {"shape",  "material", "name",  "transform",
+                                           "radius", "centre",   "level", NULL};
+        static const float zero[3] = {0, 0, 0};
+        float radius, centre[3];
+        int level;
+        if (check_keys(c, o, p, keys) ||
+            get_float(c, o, p, "radius", FLT_MIN, FLT_MAX, 1, 0, &radius) ||
+            get_vec(c, o, p, "centre", 3, -FLT_MAX, FLT_MAX, zero, centre) ||
+            get_int(c, o, p, "level", 0, 7, 3, 0, &level))
+            return -1;
+        rc = shape_sphere(m, level);
+        if (!rc) {
+            mat4 xf = mat4_mul(mat4_translate(v3(centre[0], centre[1], centre[2])),
+                               mat4_scale(v3(radius, radius, radius)));
+            mesh_transform(m, &xf);
+        }
+    } else if (strcmp(shape, "box") == 0) {
+        static const char *const keys[] = {"shape", "material", "name", "transform", "size", NULL};
+        static const float one[3] = {1, 1, 1};
+        float size[3];
+        if (check_keys(c, o, p, keys) || get_vec(c, o, p, "size", 3, FLT_MIN, FLT_MAX, one, size))
+            return -1;
+        rc = shape_box(m, v3(size[0], size[1], size[2]));
+    } else if (strcmp(shape, "prism") == 0) {
+        static const char *const keys[] = {"shape",  "material", "name", "transform",
+                                           "points", "depth",    NULL};
+        float pts[3][2] = {{-0.5f, -0.288675f}, {0.5f, -0.288675f}, {0.0f, 0.577350f}};
+        float depth;
+        if (check_keys(c, o, p, keys) ||
+            get_float(c, o, p, "depth", FLT_MIN, FLT_MAX, 1, 0, &depth))
+            return -1;
+        const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "points");
+        path_key(q, p, "points");
+        if (pj) {
+            if (!cJSON_IsArray(pj) || cJSON_GetArraySize(pj) != 3)
+                return fail(c, q, "expected 3 points [x, y]");
+            int i = 0;
+            for (const cJSON *e = pj->child; e; e = e->next, i++) {
+                char qi[PATH_MAX_LEN];
+                path_index(qi, q, i);
+                if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, pts[i])) return -1;
+            }
+        }
+        double area = (pts[1][0] - pts[0][0]) * (pts[2][1] - pts[0][1]) -
+                      (pts[2][0] - pts[0][0]) * (pts[1][1] - pts[0][1]);
+        if (area == 0) return fail(c, q, "the three points are on one line");
+        rc = shape_prism(m, (const float(*)[2])pts, depth);
+    } else if (strcmp(shape, "quad") == 0) {
+        static const char *const keys[] = {"shape", "material", "name", "transform", "size", NULL};
+        static const float one[2] = {1, 1};
+        float size[2];
+        if (check_keys(c, o, p, keys) || get_vec(c, o, p, "size", 2, FLT_MIN, FLT_MAX, one, size))
+            return -1;
+        rc = shape_quad(m, size[0], size[1]);
+    } else if (strcmp(shape, "revolution") == 0) {
+        static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                           "profile", "segments", "caps", NULL};
+        int segments;
+        if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
+            return -1;
+        const cJSON *caps = cJSON_GetObjectItemCaseSensitive(o, "caps");
+        path_key(q, p, "caps");
+        if (caps && !cJSON_IsBool(caps))
+            return fail(c, q, "expected true or false, got %s", json_type_name(caps));
+        path_key(q, p, "profile");
+        const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "profile");
+        if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
+        int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
+        if (n < 2 || n > 100000)
+            return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
+        float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
+        if (!prof) return fail(c, NULL, "out of memory");
+        int i = 0;
+        for (const cJSON *e = pj->child; e; e = e->next, i++) {
+            char qi[PATH_MAX_LEN];
+            path_index(qi, q, i);
+            if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, prof[i])) {
+                free(prof);
+                return -1;
+            }
+            if (prof[i][0] < 0) {
+                free(prof);
+                return fail(c, qi, "the radius r must be >= 0");
+            }
+            if (i > 0 && prof[i][0] == prof[i - 1][0] && prof[i][1] == prof[i - 1][1]) {
+                free(prof);
+                return fail(c, qi, "repeats the previous point");
+            }
+        }
+        rc = shape_revolution(m, (const float(*)[2])prof, n, segments,
+                              caps ? cJSON_IsTrue(caps) : 1);
+        free(prof);
+    } else {
+        path_key(q, p, "shape");
+        return fail(c, q,
+                    "unknown shape \"%s\" (expected mesh, sphere, box, prism, quad or revolution)",
+                    shape);
+    }
+    if (rc) return fail(c, p, "could not tessellate the shape (out of memory)");
+    return 0;
+}
+
+static int load_objects(Ctx *c, const cJSON *j, Scene *s)
+{
+    if (!j) return fail(c, "objects", "missing (expected an array of objects)");
+    if (!cJSON_IsArray(j))
+        return fail(c, "objects", "expected an array, got %s", json_type_name(j));
+    int n = cJSON_GetArraySize(j);
+    if (n == 0) return fail(c, "objects", "the scene is empty: expected at least one object");
+    s->objects = calloc((size_t)n, sizeof *s->objects);
+    if (!s->objects) return fail(c, NULL, "out of memory");
+    int i = 0;
+    for (const cJSON *o = j->child; o; o = o->next, i++) {
+        char p[PATH_MAX_LEN], q[PATH_MAX_LEN];
+        path_index(p, "objects", i);
+        if (expect_object(c, o, p)) return -1;
+        SceneObject *ob = &s->objects[i];
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(o, "name");
+        path_key(q, p, "name");
+        if (name && (!cJSON_IsString(name) || strlen(name->valuestring) >= SCENE_NAME_MAX))
+            return fail(c, q, "expected a string of at most %d characters", SCENE_NAME_MAX - 1);
+        snprintf(ob->name, sizeof ob->name, "%s", name ? name->valuestring : p);
+        const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
+        path_key(q, p, "shape");
+        if (!shape)
+            return fail(c, q, "missing (expected mesh, sphere, box, prism, quad or revolution)");
+        if (!cJSON_IsString(shape))
+            return fail(c, q, "expected a string, got %s", json_type_name(shape));
+        const cJSON *mat = cJSON_GetObjectItemCaseSensitive(o, "material");
+        path_key(q, p, "material");
+        if (!mat) return fail(c, q, "missing (expected the name of a material)");
+        if (!cJSON_IsString(mat))
+            return fail(c, q, "expected a string, got %s", json_type_name(mat));
+        ob->material = find_material(s, mat->valuestring);
+        if (ob->material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+        Mesh m;
+        mesh_init(&m);
+        mat4 xf;
+        if (load_shape(c, o, p, shape->valuestring, s, &m) || load_transform(c, o, p, &xf)) {
+            mesh_free(&m);
+            return -1;
+        }
+        mesh_transform(&m, &xf);
+        for (uint32_t v = 0; v < m.nverts; v++)
+            if (!isfinite(m.verts[v].x + m.verts[v].y + m.verts[v].z)) {
+                mesh_free(&m);
+                return fail(c, p, "vertex %u is not finite after the transform", v);
+            }
+        if ((uint64_t)s->mesh.ntris + m.ntris > SCENE_MAX_TRIANGLES) {
+            mesh_free(&m);
+            return fail(c, p, "the scene has more than %u triangles", SCENE_MAX_TRIANGLES);
+        }
+        ob->first_tri = s->mesh.ntris;
+        ob->ntris = m.ntris;
+        int err = mesh_append(&s->mesh, &m);
+        mesh_free(&m);
+        if (err) return fail(c, NULL, "out of memory");
+        uint32_t *tm =
+            realloc(s->tri_material, sizeof(uint32_t) * (s->mesh.ntris ? s->mesh.ntris : 1));
+        if (!tm) return fail(c, NULL, "out of memory");
+        s->tri_material = tm;
+        for (uint32_t t = ob->first_tri; t < s->mesh.ntris; t++) tm[t] = (uint32_t)ob->material;
+    }
+    s->nobjects = n;
+    if (s->mesh.ntris == 0) return fail(c, "objects", "no triangles to render");
+    return 0;
+}
+
+int scene_load(const char *path, Scene *s, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"description", "image",     "camera",  "render",
+                                       "lights",      "materials", "objects", NULL};
+    Ctx c = {path, err, errlen};
+    memset(s, 0, sizeof *s);
+    mesh_init(&s->mesh);
+    char *text = NULL;
+    cJSON *root = NULL;
+    if (!(s->path = dup_string(path))) goto oom;
+    if (!(s->dir = dup_string(path))) goto oom;
+    char *slash = strrchr(s->dir, '/');
+    if (slash)
+        *(slash == s->dir ? slash + 1 : slash) = 0;
+    else
+        s->dir[0] = 0;
+    if (read_file(&c, path, &text)) goto fail;
+    const char *end = NULL;
+    root = cJSON_ParseWithOpts(text, &end, 1);
+    if (!root) {
+        const char *at = end ? end : cJSON_GetErrorPtr();
+        int line, col;
+        if (!at) at = text;
+        text_position(text, at, &line, &col);
+        char near[24] = "";
+        size_t k = 0;
+        for (const char *q = at; *q && *q != '\n' && k < 16; q++) near[k++] = *q;
+        near[k] = 0;
+        if (*at == 0)
+            snprintf(err, errlen, "%s:%d:%d: JSON syntax error: unexpected end of file", path, line,
+                     col);
+        else
+            snprintf(err, errlen, "%s:%d:%d: JSON syntax error near \"%s\"", path, line, col, near);
+        goto fail;
+    }
+    if (expect_object(&c, root, "") || check_keys(&c, root, "", keys)) goto fail;
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (!cam) {
+        fail(&c, "camera", "missing (expected an object with eye and look_at)");
+        goto fail;
+    }
+    const cJSON *img = cJSON_GetObjectItemCaseSensitive(root, "image");
+    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (desc && !cJSON_IsString(desc)) {
+        fail(&c, "description", "expected a string, got %s", json_type_name(desc));
+        goto fail;
+    }
+    if (img) {
+        if (load_image(&c, img, s)) goto fail;
+    } else {
+        s->width = s->height = 400;
+    }
+    if (load_camera(&c, cam, s) ||
+        load_render(&c, cJSON_GetObjectItemCaseSensitive(root, "render"), s) ||
+        load_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights"), s) ||
+        load_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
+        load_objects(&c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
+        goto fail;
+    cJSON_Delete(root);
+    free(text);
+    return 0;
+oom:
+    snprintf(err, errlen, "%s: out of memory", path);
+fail:
+    cJSON_Delete(root);
+    free(text);
+    scene_free(s);
+    return 2;
+}
+
+void scene_free(Scene *s)
+{
+    free(s->path);
+    free(s->dir);
+    free(s->output);
+    free(s->lights);
+    free(s->materials);
+    free(s->objects);
+    free(s->tri_material);
+    mesh_free(&s->mesh);
+    memset(s, 0, sizeof *s);
+}
