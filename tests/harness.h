@@ -1,0 +1,33 @@
+/* harness.h — the whole test harness: named tests, checks that report where they failed,
+ * and a closing line "N passed, N failed" (a test passes when none of its checks fail). */
+#ifndef VBCL_HARNESS_H
+#define VBCL_HARNESS_H
+
+#include <stdio.h>
+
+extern int th_checks_failed; /* failed checks in the running test */
+
+/* Records a failed check with its location and a printf-style explanation; the first
+ * 8 failures of a test are printed, the rest only counted. */
+void th_fail(const char *file, int line, const char *expr, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+#define CHECK(cond, ...)                                                                           \
+    do {                                                                                           \
+        if (!(cond)) th_fail(__FILE__, __LINE__, #cond, __VA_ARGS__);                              \
+    } while (0)
+
+/* Runs fn as one test unless a name filter excludes it; prints "ok NAME" or "FAIL NAME". */
+void th_run(const char *name, void (*fn)(void));
+#define RUN_TEST(fn) th_run(#fn, fn)
+
+/* Marks the running test skipped (counted apart, never as passed) and says why. */
+void th_skip(const char *why);
+
+/* Runs only tests whose name contains f (NULL: all). */
+void th_set_filter(const char *f);
+
+/* Prints "N passed, N failed[, N skipped]" and returns the exit status (1 if any failed). */
+int th_summary(void);
+
+#endif

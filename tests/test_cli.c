@@ -1,0 +1,154 @@
+/* test_cli.c — the vbcl binary as a user meets it: help, devices, options, and bad input
+ * of every class giving exit 2, a one-line message, and no output file touched. */
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "harness.h"
+#include "testutil.h"
+
+#define GOOD_SCENE                                                                                 \
+    "{\"image\": {\"width\": 24, \"height\": 16},\n"                                               \
+    " \"camera\": {\"eye\": [0, 1, 5], \"look_at\": [0, 0, 0]},\n"                                 \
+    " \"lights\": [{\"centre\": [2, 4, 3], \"radius\": 0.5, \"flux\": 500}],\n"                    \
+    " \"materials\": {\"m\": {}},\n"                                                               \
+    " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}]}\n"
+
+static int file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static int vbcl(const char *args, char *out, size_t n)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s %s", tu_vbcl, args);
+    return tu_run(cmd, out, n);
+}
+
+static void test_cli_help_and_usage(void)
+{
+    char out[8192];
+    CHECK(vbcl("--help", out, sizeof out) == 0, "--help exits 0");
+    CHECK(strstr(out, "usage: vbcl SCENE.json") && strstr(out, "--grid") &&
+              strstr(out, "--list-devices") && strstr(out, "--stats"),
+          "--help lists the options: %s", out);
+    CHECK(vbcl("", out, sizeof out) == 2, "no scene: exit 2");
+    CHECK(vbcl("--frobnicate x.json", out, sizeof out) == 2 && strstr(out, "--frobnicate"),
+          "unknown option named: %s", out);
+    CHECK(vbcl("scene.json --width", out, sizeof out) == 2 && strstr(out, "needs a value"),
+          "missing value: %s", out);
+    CHECK(vbcl("scene.json --width 0", out, sizeof out) == 2, "width 0 rejected");
+}
+
+static void test_cli_list_devices(void)
+{
+    char out[8192];
+    int rc = vbcl("--list-devices", out, sizeof out);
+    CHECK(rc == 0, "--list-devices exits 0 (%d): %s", rc, out);
+    CHECK(strncmp(out, "0: ", 3) == 0, "devices listed with an index: %s", out);
+}
+
+static void test_cli_renders_and_overrides(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file("good.json", GOOD_SCENE);
+    char out[8192], args[2048], img[512];
+    snprintf(img, sizeof img, "%s/good.exr", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s --width 20 --height 10 --grid 4 --stats", scene, img);
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 0, "render exits 0 (%d): %s", rc, out);
+    CHECK(strstr(out, "(20x10)") != NULL, "command line overrides the size: %s", out);
+    CHECK(strstr(out, "4x4x4") != NULL, "command line overrides the grid: %s", out);
+    CHECK(strstr(out, "rays        primary 200") != NULL, "--stats counts primary rays: %s", out);
+    CHECK(file_exists(img), "image written");
+    /* from another working directory: kernels are embedded, mesh paths are scene-relative */
+    snprintf(args, sizeof args, "cd / && %s%s -q %s -o %s/good.png",
+             tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, scene, tu_tmpdir());
+    rc = tu_run(args, out, sizeof out);
+    CHECK(rc == 0 && out[0] == 0, "runs from another directory, -q prints nothing (%d): %s", rc,
+          out);
+    CHECK(vbcl("--device 99 --list-devices", out, sizeof out) == 0, "listing ignores --device");
+    snprintf(args, sizeof args, "%s -o %s/x.png --device 99", scene, tu_tmpdir());
+    CHECK(vbcl(args, out, sizeof out) == 2 && strstr(out, "no such device"), "bad device index: %s",
+          out);
+    snprintf(args, sizeof args, "%s -o %s/x.png --device no-such-gpu", scene, tu_tmpdir());
+    CHECK(vbcl(args, out, sizeof out) == 2 && strstr(out, "no-such-gpu"), "bad device name: %s",
+          out);
+}
+
+/* A bad input must give exit 2, a one-line message containing `needle`, and leave the
+ * existing output file exactly as it was. */
+static void expect_bad(const char *scene_text, const char *extra_args, const char *needle)
+{
+    const char *scene = tu_write_file("bad.json", scene_text);
+    char img[512], args[2048], out[8192];
+    snprintf(img, sizeof img, "%s/keep.png", tu_tmpdir());
+    FILE *f = fopen(img, "w");
+    if (f) {
+        fputs("previous image", f);
+        fclose(f);
+    }
+    snprintf(args, sizeof args, "%s -o %s %s", scene, img, extra_args ? extra_args : "");
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2, "exit 2 for bad input (got %d): %s", rc, out);
+    CHECK(strstr(out, needle) != NULL, "message \"%s\" names \"%s\"", out, needle);
+    char *nl = strchr(out, '\n');
+    CHECK(nl && nl[1] == 0, "exactly one line: %s", out);
+    char buf[64] = "";
+    f = fopen(img, "r");
+    if (f) {
+        size_t n = fread(buf, 1, sizeof buf - 1, f);
+        buf[n] = 0;
+        fclose(f);
+    }
+    CHECK(strcmp(buf, "previous image") == 0, "existing output untouched");
+}
+
+static void test_cli_bad_input_classes(void)
+{
+    expect_bad("{\"camera\": ", NULL, "bad.json:1:"); /* malformed JSON */
+    expect_bad("{\"camera\": {\"eye\": \"here\", \"look_at\": [0,0,0]}}", NULL,
+               "camera.eye"); /* type */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0], \"zoom\": 2}}", NULL,
+               "camera.zoom"); /* unknown key */
+    expect_bad(
+        "{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
+        " \"objects\": [{\"shape\": \"mesh\", \"file\": \"nope.obj\", \"material\": \"m\"}]}",
+        NULL, "nope.obj"); /* missing mesh */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1e400], \"look_at\": [0,0,0]}}", NULL,
+               "finite"); /* non-finite */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
+               " \"objects\": [{\"shape\": \"box\", \"size\": [1, -1, 1], \"material\": \"m\"}]}",
+               NULL, "objects[0].size[1]"); /* negative size */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
+               " \"objects\": []}",
+               NULL, "empty"); /* empty scene */
+    expect_bad(
+        "{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
+        " \"objects\": [{\"shape\": \"revolution\", \"segments\": 100000000, \"material\": \"m\","
+        " \"profile\": [[0, 0], [1, 1]]}]}",
+        NULL, "segments");                        /* absurd count */
+    expect_bad(GOOD_SCENE, "--grid 0", "--grid"); /* bad option */
+    char out[4096];
+    const char *scene = tu_write_file("good.json", GOOD_SCENE);
+    char args[1024];
+    snprintf(args, sizeof args, "%s -o %s/out.bmp", scene, tu_tmpdir());
+    CHECK(vbcl(args, out, sizeof out) == 2 && strstr(out, "bmp"), "unknown image format: %s", out);
+    snprintf(args, sizeof args, "%s/does-not-exist.json", tu_tmpdir());
+    CHECK(vbcl(args, out, sizeof out) == 2 && strstr(out, "does-not-exist.json") &&
+              strstr(out, "No such file"),
+          "missing scene: %s", out);
+}
+
+void suite_cli(void)
+{
+    RUN_TEST(test_cli_help_and_usage);
+    RUN_TEST(test_cli_list_devices);
+    RUN_TEST(test_cli_renders_and_overrides);
+    RUN_TEST(test_cli_bad_input_classes);
+}

@@ -1,0 +1,389 @@
+/* test_kernels.c — the kernels on the device they run on: struct layout as the device
+ * compiles it, the grid against brute force, irradiance from spherical lights against
+ * the closed form, and rays through the edges and vertices of a closed mesh. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "render.h"
+#include "testutil.h"
+
+/* A scene loaded from JSON text and prepared on the test device with the probe kernels. */
+typedef struct Fixture {
+    Scene s;
+    Renderer r;
+    int ok;
+} Fixture;
+
+static int fixture_open(Fixture *fx, const char *json)
+{
+    memset(fx, 0, sizeof *fx);
+    VbDevice *d = tu_device();
+    if (!d) {
+        th_skip("no OpenCL device");
+        return -1;
+    }
+    char err[1024];
+    const char *path = tu_write_file("fixture.json", json);
+    if (scene_load(path, &fx->s, err, sizeof err)) {
+        CHECK(0, "fixture scene: %s", err);
+        return -1;
+    }
+    RenderStats st;
+    memset(&st, 0, sizeof st);
+    if (renderer_init(&fx->r, d, &fx->s, "-DVBCL_TEST_KERNELS", &st, err, sizeof err)) {
+        CHECK(0, "renderer_init: %s", err);
+        scene_free(&fx->s);
+        return -1;
+    }
+    /* the frame buffer normally written per tile */
+    if (clEnqueueWriteBuffer(d->queue, fx->r.frame, CL_TRUE, 0, sizeof(VbFrame), &fx->r.frame_host,
+                             0, NULL, NULL) != CL_SUCCESS) {
+        CHECK(0, "frame upload failed");
+        return -1;
+    }
+    fx->ok = 1;
+    return 0;
+}
+
+static void fixture_close(Fixture *fx)
+{
+    if (fx->ok) renderer_release(&fx->r);
+    if (fx->ok) scene_free(&fx->s);
+    fx->ok = 0;
+}
+
+static cl_mem buffer(const void *data, size_t bytes)
+{
+    VbDevice *d = tu_device();
+    cl_int rc;
+    cl_mem m = clCreateBuffer(d->context, CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0),
+                              bytes, (void *)data, &rc);
+    CHECK(rc == CL_SUCCESS, "clCreateBuffer: %s", clu_error_name(rc));
+    return m;
+}
+
+/* Runs kernel `name` over n work items with the given arguments (all cl_mem or int). */
+static int run_kernel(cl_program prog, const char *name, size_t n, int nargs, const size_t *sizes,
+                      const void *const *vals)
+{
+    VbDevice *d = tu_device();
+    cl_int rc;
+    cl_kernel k = clCreateKernel(prog, name, &rc);
+    CHECK(rc == CL_SUCCESS, "clCreateKernel(%s): %s", name, clu_error_name(rc));
+    if (rc != CL_SUCCESS) return -1;
+    for (int i = 0; i < nargs; i++) {
+        rc = clSetKernelArg(k, (cl_uint)i, sizes[i], vals[i]);
+        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, i, clu_error_name(rc));
+    }
+    size_t global = (n + 63) / 64 * 64;
+    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);
+    CHECK(rc == CL_SUCCESS, "enqueue %s: %s", name, clu_error_name(rc));
+    clFinish(d->queue);
+    clReleaseKernel(k);
+    return rc == CL_SUCCESS ? 0 : -1;
+}
+
+static void read_buffer(cl_mem m, void *dst, size_t bytes)
+{
+    cl_int rc = clEnqueueReadBuffer(tu_device()->queue, m, CL_TRUE, 0, bytes, dst, 0, NULL, NULL);
+    CHECK(rc == CL_SUCCESS, "read: %s", clu_error_name(rc));
+}
+
+/* Closest hits of rays through the grid (scene_intersect_closest). */
+static void trace_grid(Fixture *fx, cl_mem rays, int n, cl_mem hits, cl_mem counters)
+{
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                         sizeof(cl_mem), sizeof(int),    sizeof(cl_mem), sizeof(cl_mem)};
+    const void *v[] = {&fx->r.frame, &fx->r.tris, &fx->r.cell_start, &fx->r.cell_tris, &rays,
+                       &n,           &hits,       &counters};
+    run_kernel(fx->r.program, "scene_intersect_closest", (size_t)n, 8, sz, v);
+}
+
+static void test_kernel_struct_layout(void)
+{
+    Fixture fx;
+    if (fixture_open(
+            &fx,
+            "{\"camera\": {\"eye\": [0,0,5], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
+            " \"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    cl_uint out[10] = {0};
+    cl_mem m = buffer(NULL, sizeof out);
+    const size_t sz[] = {sizeof(cl_mem)};
+    const void *v[] = {&m};
+    run_kernel(fx.r.program, "probe_layout", 1, 1, sz, v);
+    read_buffer(m, out, sizeof out);
+    const cl_uint want[10] = {sizeof(VbRay),
+                              sizeof(VbHit),
+                              sizeof(VbTriangle),
+                              sizeof(VbMaterial),
+                              sizeof(VbLight),
+                              sizeof(VbFrame),
+                              offsetof(VbFrame, background),
+                              offsetof(VbFrame, seed),
+                              offsetof(VbMaterial, eta),
+                              offsetof(VbLight, radiance)};
+    for (int i = 0; i < 10; i++)
+        CHECK(out[i] == want[i], "layout item %d: device %u, host %u", i, out[i], want[i]);
+    clReleaseMemObject(m);
+    fixture_close(&fx);
+}
+
+static float frand(unsigned *state)
+{
+    *state = *state * 1664525u + 1013904223u;
+    return (float)(*state >> 8) * (1.0f / 16777216.0f);
+}
+
+/* Random rays: half from a sphere around the scene toward a random point inside its
+ * bounds, half from inside the bounds in a random direction. */
+static void random_rays(const Scene *s, VbRay *rays, int n, unsigned seed)
+{
+    vec3 lo, hi;
+    mesh_bounds(&s->mesh, &lo, &hi);
+    vec3 c = v3_scale(v3_add(lo, hi), 0.5f), ext = v3_sub(hi, lo);
+    float rad = v3_len(ext);
+    for (int i = 0; i < n; i++) {
+        vec3 target = v3(lo.x + ext.x * frand(&seed), lo.y + ext.y * frand(&seed),
+                         lo.z + ext.z * frand(&seed));
+        vec3 org, dir;
+        if (i & 1) {
+            org = v3(lo.x + ext.x * frand(&seed), lo.y + ext.y * frand(&seed),
+                     lo.z + ext.z * frand(&seed));
+            dir = v3_norm(v3(frand(&seed) - 0.5f, frand(&seed) - 0.5f, frand(&seed) - 0.5f));
+        } else {
+            vec3 u = v3_norm(v3(frand(&seed) - 0.5f, frand(&seed) - 0.5f, frand(&seed) - 0.5f));
+            org = v3_add(c, v3_scale(u, rad * 1.5f));
+            dir = v3_norm(v3_sub(target, org));
+        }
+        VbRay *r = &rays[i];
+        r->org[0] = org.x;
+        r->org[1] = org.y;
+        r->org[2] = org.z;
+        r->dir[0] = dir.x;
+        r->dir[1] = dir.y;
+        r->dir[2] = dir.z;
+        r->tmax = INFINITY;
+        r->sample = (unsigned)i;
+    }
+}
+
+/* Grid and brute force agree on the closest hit of n random rays for the scene. */
+static void compare_grid_brute(const char *label, const char *json, const char *grid, int n)
+{
+    char text[4096];
+    snprintf(text, sizeof text, json, grid);
+    Fixture fx;
+    if (fixture_open(&fx, text)) return;
+    VbRay *rays = malloc(sizeof *rays * (size_t)n);
+    VbHit *hg = malloc(sizeof *hg * (size_t)n), *hb = malloc(sizeof *hb * (size_t)n);
+    random_rays(&fx.s, rays, n, 12345u);
+    cl_mem mr = buffer(rays, sizeof *rays * (size_t)n);
+    cl_mem mg = buffer(NULL, sizeof *hg * (size_t)n), mb = buffer(NULL, sizeof *hb * (size_t)n);
+    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_mem mc = buffer(zero, sizeof zero);
+    trace_grid(&fx, mr, n, mg, mc);
+    cl_uint ntris = fx.s.mesh.ntris;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
+                         sizeof(cl_mem)};
+    const void *v[] = {&fx.r.tris, &ntris, &mr, &n, &mb};
+    run_kernel(fx.r.program, "probe_intersect_brute", (size_t)n, 5, sz, v);
+    read_buffer(mg, hg, sizeof *hg * (size_t)n);
+    read_buffer(mb, hb, sizeof *hb * (size_t)n);
+    int hits = 0, ties = 0, bad = 0;
+    for (int i = 0; i < n; i++) {
+        hits += hb[i].tri >= 0;
+        if (hg[i].tri == hb[i].tri) {
+            if (hb[i].tri >= 0 && fabsf(hg[i].t - hb[i].t) > 1e-5f * fabsf(hb[i].t)) {
+                bad++;
+                CHECK(0, "%s grid %s ray %d: t %.9g vs brute %.9g", label, grid, i, hg[i].t,
+                      hb[i].t);
+            }
+        } else if (hg[i].tri >= 0 && hb[i].tri >= 0 &&
+                   fabsf(hg[i].t - hb[i].t) <= 1e-5f * fabsf(hb[i].t)) {
+            ties++; /* two triangles at the same distance (a shared edge): either is right */
+        } else {
+            bad++;
+            CHECK(0, "%s grid %s ray %d: triangle %d t %.9g vs brute %d t %.9g", label, grid, i,
+                  hg[i].tri, hg[i].t, hb[i].tri, hb[i].t);
+        }
+    }
+    fprintf(stderr,
+            "    %s, grid %s (%dx%dx%d): %d rays, %d hit, %d ties at equal t, %d mismatches\n",
+            label, grid, fx.r.grid.n[0], fx.r.grid.n[1], fx.r.grid.n[2], n, hits, ties, bad);
+    CHECK(hits > n / 10, "%s: enough rays hit (%d of %d)", label, hits, n);
+    CHECK(ties < n / 1000 + 5, "%s: ties are rare (%d)", label, ties);
+    clReleaseMemObject(mr);
+    clReleaseMemObject(mg);
+    clReleaseMemObject(mb);
+    clReleaseMemObject(mc);
+    free(rays);
+    free(hg);
+    free(hb);
+    fixture_close(&fx);
+}
+
+#define CAM "\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
+
+static void test_grid_matches_brute_force(void)
+{
+    /* %s is the grid resolution */
+    static const char *spheres =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"
+        "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.4, \"centre\": [2, 1, 0], "
+        "\"material\": \"m\"},"
+        "{\"shape\": \"box\", \"size\": [6, 0.2, 6], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}";
+    static const char *vase =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"revolution\", \"segments\": 40, \"material\": \"m\","
+        " \"profile\": [[0, 0], [0.5, 0], [0.8, 0.4], [0.9, 0.9], [0.6, 1.5], [0.3, 2], [0.45, "
+        "2.2]]},"
+        "{\"shape\": \"prism\", \"depth\": 3, \"material\": \"m\", \"transform\": {\"scale\": 2}},"
+        "{\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"m\"}]}";
+    static const char *grids[] = {"1", "\"auto\"", "64"};
+    for (int g = 0; g < 3; g++) {
+        compare_grid_brute("spheres and a slab", spheres, grids[g], 100000);
+        compare_grid_brute("vase, prism and floor", vase, grids[g], 100000);
+    }
+    compare_grid_brute("spheres and a slab", spheres, "[7, 3, 19]", 100000);
+}
+
+/* Local shading at points under a spherical light, diffuse reflectance 1, no ambient:
+ * outgoing radiance = E / pi with E = pi L sin^2(alpha) cos(beta) whenever the whole cap
+ * is above the horizon (alpha: the cap's half angle, beta: the tilt of the normal). */
+static void test_light_irradiance_closed_form(void)
+{
+    Fixture fx;
+    /* the only geometry is a small box far behind the light, so nothing occludes */
+    if (fixture_open(&fx,
+                     "{" CAM "\"render\": {\"shadow_samples\": 1024, \"ambient\": [0, 0, 0]},"
+                     " \"lights\": [{\"centre\": [0, 0, 0], \"radius\": 1, \"flux\": 1000},"
+                     "              {\"centre\": [0, 0, 0], \"radius\": 0, \"intensity\": 0.001}],"
+                     " \"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}},"
+                     " \"objects\": [{\"shape\": \"box\", \"material\": \"m\", \"transform\": "
+                     "{\"translate\": [0, 0, -100]}}]}"))
+        return;
+    const double flux = 1000.0, R = 1.0, I_point = 0.001;
+    const double L = flux / (4.0 * M_PI * M_PI * R * R);
+    enum { N = 6 };
+    /* distance d, tilt beta (degrees), in the plane of x and y */
+    const double cases[N][2] = {{5, 0}, {1.05, 0}, {20, 40}, {3, 60}, {1.5, 30}, {2, 25}};
+    float pts[N * 4], nrm[N * 4], out[N * 4];
+    for (int i = 0; i < N; i++) {
+        double d = cases[i][0], b = cases[i][1] * M_PI / 180.0;
+        /* point on +x at distance d; the normal points back at the light, tilted by beta */
+        pts[4 * i] = (float)d, pts[4 * i + 1] = 0, pts[4 * i + 2] = 0, pts[4 * i + 3] = 0;
+        nrm[4 * i] = (float)-cos(b), nrm[4 * i + 1] = (float)sin(b), nrm[4 * i + 2] = 0,
+                nrm[4 * i + 3] = 0;
+    }
+    cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
+           mo = buffer(NULL, sizeof out);
+    int n = N;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                         sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                         sizeof(int),    sizeof(cl_mem)};
+    const void *v[] = {&fx.r.frame,
+                       &fx.r.tris,
+                       &fx.r.cell_start,
+                       &fx.r.cell_tris,
+                       &fx.r.materials,
+                       &fx.r.lights,
+                       &mp,
+                       &mn,
+                       &n,
+                       &mo};
+    run_kernel(fx.r.program, "probe_shade_points", N, 10, sz, v);
+    read_buffer(mo, out, sizeof out);
+    for (int i = 0; i < N; i++) {
+        double d = cases[i][0], b = cases[i][1] * M_PI / 180.0, s2 = R * R / (d * d);
+        double alpha = asin(R / d);
+        CHECK(b + alpha < M_PI / 2, "case %d: the cap must be above the horizon", i);
+        double e_sphere = M_PI * L * s2 * cos(b);
+        double e_point = I_point * cos(b) / (d * d);
+        double want = (e_sphere + e_point) / M_PI;
+        double got = out[4 * i];
+        fprintf(stderr,
+                "    d %.2f tilt %2.0f: radiance %.6g, closed form %.6g (rel. error %.2e)\n", d,
+                cases[i][1], got, want, fabs(got - want) / want);
+        CHECK(fabs(got - want) <= 1e-3 * want, "case %d: radiance %.6g, closed form %.6g", i, got,
+              want);
+    }
+    /* facing away from both lights: no feelers, no light */
+    nrm[0] = 1, nrm[1] = 0, nrm[2] = 0;
+    n = 1;
+    clEnqueueWriteBuffer(tu_device()->queue, mn, CL_TRUE, 0, sizeof(float) * 4, nrm, 0, NULL, NULL);
+    run_kernel(fx.r.program, "probe_shade_points", 1, 10, sz, v);
+    read_buffer(mo, out, sizeof(float) * 4);
+    CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced", out[0],
+          out[3]);
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mn);
+    clReleaseMemObject(mo);
+    fixture_close(&fx);
+}
+
+/* Rays aimed exactly at every vertex and every edge midpoint of closed meshes, from
+ * outside toward the centre, must all hit: none slips between two triangles. */
+static void test_rays_at_edges_and_vertices_hit(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{" CAM "\"materials\": {\"m\": {}}, \"objects\": ["
+                          "{\"shape\": \"sphere\", \"level\": 3, \"material\": \"m\"},"
+                          "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","
+                          " \"profile\": [[0, -1], [1, 0], [0, 1]], \"transform\": {\"translate\": "
+                          "[5, 0, 0]}}]}"))
+        return;
+    const Mesh *m = &fx.s.mesh;
+    int n = (int)(m->nverts + 3 * m->ntris);
+    VbRay *rays = calloc((size_t)n, sizeof *rays);
+    VbHit *hits = calloc((size_t)n, sizeof *hits);
+    int k = 0;
+    for (uint32_t t = 0; t < m->ntris; t++) {
+        for (int e = 0; e < 4; e++) {
+            vec3 p;
+            if (e == 3) {
+                if (t >= m->nverts) continue;
+                p = m->verts[t];
+            } else {
+                vec3 a = m->verts[m->tris[3 * t + e]], b = m->verts[m->tris[3 * t + (e + 1) % 3]];
+                p = v3_scale(v3_add(a, b), 0.5f);
+            }
+            vec3 c = p.x > 2.5f ? v3(5, 0, 0) : v3(0, 0, 0);
+            vec3 dir = v3_norm(v3_sub(p, c));
+            vec3 org = v3_add(c, v3_scale(dir, 4.0f));
+            VbRay *r = &rays[k++];
+            r->org[0] = org.x, r->org[1] = org.y, r->org[2] = org.z;
+            r->dir[0] = -dir.x, r->dir[1] = -dir.y, r->dir[2] = -dir.z;
+            r->tmax = INFINITY;
+        }
+    }
+    n = k;
+    cl_mem mr = buffer(rays, sizeof *rays * (size_t)n), mh = buffer(NULL, sizeof *hits * (size_t)n);
+    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_mem mc = buffer(zero, sizeof zero);
+    trace_grid(&fx, mr, n, mh, mc);
+    read_buffer(mh, hits, sizeof *hits * (size_t)n);
+    int miss = 0;
+    for (int i = 0; i < n; i++) miss += hits[i].tri < 0;
+    fprintf(stderr, "    %d rays at edges and vertices, %d leaked\n", n, miss);
+    CHECK(miss == 0, "%d of %d rays at edges and vertices passed through", miss, n);
+    clReleaseMemObject(mr);
+    clReleaseMemObject(mh);
+    clReleaseMemObject(mc);
+    free(rays);
+    free(hits);
+    fixture_close(&fx);
+}
+
+void suite_kernels(void)
+{
+    RUN_TEST(test_kernel_struct_layout);
+    RUN_TEST(test_grid_matches_brute_force);
+    RUN_TEST(test_light_irradiance_closed_form);
+    RUN_TEST(test_rays_at_edges_and_vertices_hit);
+}

@@ -1,0 +1,104 @@
+/* test_main.c — runs every suite; usage: vbcl-tests [--vbcl PATH] [NAME-FILTER]. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "testutil.h"
+
+const char *tu_vbcl = "./vbcl";
+static VbDevice device;
+static int device_state; /* 0 untried, 1 open, -1 failed */
+static char tmpdir[256];
+
+VbDevice *tu_device(void)
+{
+    if (device_state == 0) {
+        char err[512];
+        if (clu_device_open(getenv("VBCL_DEVICE"), &device, err, sizeof err)) {
+            fprintf(stderr, "    no OpenCL device: %s\n", err);
+            device_state = -1;
+        } else {
+            device_state = 1;
+        }
+    }
+    return device_state == 1 ? &device : NULL;
+}
+
+int tu_run(const char *cmd, char *out, size_t outlen)
+{
+    char full[8192];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    if (!p) return -1;
+    size_t n = 0;
+    char buf[4096];
+    size_t got;
+    while ((got = fread(buf, 1, sizeof buf, p)) > 0) {
+        if (out && n + 1 < outlen) {
+            size_t k = got < outlen - 1 - n ? got : outlen - 1 - n;
+            memcpy(out + n, buf, k);
+            n += k;
+        }
+    }
+    if (out && outlen) out[n] = 0;
+    int st = pclose(p);
+    if (st == -1) return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+const char *tu_tmpdir(void)
+{
+    if (!tmpdir[0]) {
+        snprintf(tmpdir, sizeof tmpdir, "/tmp/vbcl-tests-XXXXXX");
+        if (!mkdtemp(tmpdir)) {
+            perror("mkdtemp");
+            exit(1);
+        }
+    }
+    return tmpdir;
+}
+
+const char *tu_write_file(const char *name, const char *text)
+{
+    static char ring[8][512];
+    static int next;
+    char *path = ring[next++ % 8];
+    snprintf(path, sizeof ring[0], "%s/%s", tu_tmpdir(), name);
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+    return path;
+}
+
+static void cleanup(void)
+{
+    if (tmpdir[0]) {
+        char cmd[512];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+        if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", tmpdir);
+    }
+    if (device_state == 1) clu_device_close(&device);
+}
+
+int main(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--vbcl") && i + 1 < argc)
+            tu_vbcl = argv[++i];
+        else
+            th_set_filter(argv[i]);
+    }
+    atexit(cleanup);
+    suite_mesh();
+    suite_grid_build();
+    suite_scene();
+    suite_cli();
+    suite_kernels();
+    suite_render();
+    return th_summary();
+}

@@ -1,0 +1,117 @@
+/* test_render.c — whole renders through the vbcl binary: a penumbra against its
+ * geometry and the closed-form irradiance, and the quickstart scene against a stored
+ * reference image. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "image_io.h"
+#include "testutil.h"
+
+static int render(const char *scene, const char *out, const char *extra)
+{
+    char cmd[2048], log[8192];
+    snprintf(cmd, sizeof cmd, "%s %s -q -o %s %s", tu_vbcl, scene, out, extra ? extra : "");
+    int rc = tu_run(cmd, log, sizeof log);
+    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
+    return rc;
+}
+
+/* The floor row z = 0 under a plate that hides the light for x < 0: lit beyond the
+ * penumbra, dark in the umbra, half the light at x = 0 (by symmetry), and in between
+ * across |x| < R h / (H - h) = 0.25 — a soft shadow, not a hard one. */
+static void test_render_penumbra_matches_geometry(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    char out[512];
+    snprintf(out, sizeof out, "%s/penumbra.exr", tu_tmpdir());
+    if (render("tests/scenes/penumbra.json", out, NULL)) return;
+    int w, h;
+    float *px;
+    char err[512];
+    if (image_read(out, &w, &h, &px, err, sizeof err)) {
+        CHECK(0, "%s", err);
+        return;
+    }
+    /* camera geometry of the scene file */
+    const double eye_y = 1.5, eye_z = 2.5, fov = 4.0 * M_PI / 180.0;
+    const double H = 10.0, intensity = 100.0;
+    double fwd_y = -eye_y / sqrt(eye_y * eye_y + eye_z * eye_z);
+    double half_w = tan(fov / 2) * (double)w / (double)h;
+    int row = h / 2, in_between = 0, lit_ok = 0, dark_ok = 0, lit_n = 0, dark_n = 0;
+    double mid_ratio = -1;
+    for (int x = 0; x < w; x++) {
+        double sx = 2.0 * (x + 0.5) / w - 1.0;
+        /* the centre row's rays lie in the plane through the eye and the x axis */
+        double xw = sx * half_w * eye_y / -fwd_y; /* where it meets the floor y = 0 */
+        double d2 = xw * xw + H * H;
+        double lit = intensity * (H / sqrt(d2)) / d2 / M_PI; /* kd/pi * I cos / d^2 */
+        double v = px[4 * ((size_t)row * w + x)];
+        if (xw > 0.3) {
+            lit_n++;
+            lit_ok += fabs(v - lit) <= 0.01 * lit;
+        } else if (xw < -0.3) {
+            dark_n++;
+            dark_ok += v <= 1e-6 * lit;
+        } else if (fabs(xw) < 0.2) {
+            in_between += v > 0.05 * lit && v < 0.95 * lit;
+        }
+        if (fabs(xw) < 0.5 * fabs(2.0 * half_w * eye_y / -fwd_y / w)) mid_ratio = v / lit;
+    }
+    fprintf(stderr,
+            "    lit %d/%d within 1%%, umbra %d/%d dark, %d penumbra pixels, x=0 at %.3f of lit\n",
+            lit_ok, lit_n, dark_ok, dark_n, in_between, mid_ratio);
+    CHECK(lit_n > 10 && lit_ok == lit_n, "fully lit floor matches I cos / d^2 (%d of %d)", lit_ok,
+          lit_n);
+    CHECK(dark_n > 10 && dark_ok == dark_n, "umbra is dark (%d of %d)", dark_ok, dark_n);
+    CHECK(in_between >= 20, "soft shadow: %d pixels strictly between lit and dark", in_between);
+    CHECK(fabs(mid_ratio - 0.5) < 0.03, "half the light at the edge of the plate: %.3f", mid_ratio);
+    free(px);
+}
+
+/* The quickstart scene at 100x100 against tests/ref/quickstart_100.png: per-pixel
+ * difference at most 0.02 (of full scale) on all but 0.5% of pixels, none above 0.1. */
+static void test_render_quickstart_reference(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    char out[512], cmd[2048], log[8192];
+    snprintf(out, sizeof out, "%s/quickstart_100.png", tu_tmpdir());
+    if (render("scenes/quickstart.json", out, "--width 100 --height 100")) return;
+    int w, h;
+    float *px;
+    char err[512];
+    if (image_read(out, &w, &h, &px, err, sizeof err)) {
+        CHECK(0, "%s", err);
+        return;
+    }
+    double sum = 0, lo = 1, hi = 0;
+    for (int i = 0; i < w * h; i++) {
+        double v = (px[4 * i] + px[4 * i + 1] + px[4 * i + 2]) / 3.0;
+        sum += v;
+        lo = fmin(lo, v);
+        hi = fmax(hi, v);
+    }
+    free(px);
+    CHECK(sum / (w * h) > 0.1 && hi - lo > 0.5, "not blank: mean %.3f, range %.3f..%.3f",
+          sum / (w * h), lo, hi);
+    snprintf(cmd, sizeof cmd,
+             "idiff -fail 0.02 -failpercent 0.5 -hardfail 0.1 -warn 0.01 -warnpercent 1 "
+             "tests/ref/quickstart_100.png %s",
+             out);
+    int rc = tu_run(cmd, log, sizeof log);
+    CHECK(rc == 0 || rc == 1, "idiff against the reference (exit %d): %s", rc, log);
+}
+
+void suite_render(void)
+{
+    RUN_TEST(test_render_penumbra_matches_geometry);
+    RUN_TEST(test_render_quickstart_reference);
+}

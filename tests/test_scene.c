@@ -1,0 +1,241 @@
+/* test_scene.c — scene loading: defaults, shapes, and one test per class of bad input,
+ * each checked for the JSON path (or file:line:col) and what was expected. */
+#include <math.h>
+#include <string.h>
+
+#include "harness.h"
+#include "scene.h"
+#include "testutil.h"
+
+#define MIN_SCENE_HEAD                                                                             \
+    "{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},\n"                                 \
+    " \"materials\": {\"m\": {}},\n"
+
+/* Loads text as a scene; returns the loader's status and leaves the message in err. */
+static int load_text(const char *text, Scene *s, char *err, size_t n)
+{
+    const char *path = tu_write_file("scene.json", text);
+    int rc = scene_load(path, s, err, n);
+    return rc;
+}
+
+static void expect_error(const char *text, const char *needle1, const char *needle2)
+{
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(text, &s, err, sizeof err);
+    CHECK(rc == 2, "expected a bad-input error for: %s", text);
+    if (rc == 0) {
+        scene_free(&s);
+        return;
+    }
+    CHECK(strstr(err, "scene.json") != NULL, "message names the file: %s", err);
+    CHECK(strstr(err, needle1) != NULL, "message \"%s\" should contain \"%s\"", err, needle1);
+    if (needle2)
+        CHECK(strstr(err, needle2) != NULL, "message \"%s\" should contain \"%s\"", err, needle2);
+    CHECK(strchr(err, '\n') == NULL, "one line: %s", err);
+}
+
+static void test_scene_minimal_defaults(void)
+{
+    Scene s;
+    char err[1024] = "";
+    int rc =
+        load_text(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}]}",
+                  &s, err, sizeof err);
+    CHECK(rc == 0, "minimal scene loads: %s", err);
+    if (rc) return;
+    CHECK(s.width == 400 && s.height == 400, "default size %dx%d", s.width, s.height);
+    CHECK(fabsf(s.fov - 45.0f) < 1e-6f, "default fov %g", s.fov);
+    CHECK(s.grid_res[0] == 0, "grid auto by default");
+    CHECK(s.max_depth == 6, "default depth %d", s.max_depth);
+    CHECK(s.nmaterials == 1 && s.materials[0].gpu.k_local == 1.0f, "material defaults");
+    CHECK(s.materials[0].gpu.ambient[0] == s.materials[0].gpu.diffuse[0],
+          "ambient defaults to diffuse");
+    CHECK(s.mesh.ntris == 20 * 64, "sphere level 3 has %u triangles", s.mesh.ntris);
+    char cerr[256];
+    CHECK(mesh_check_closed(&s.mesh, cerr, sizeof cerr) == 0, "sphere closed: %s", cerr);
+    scene_free(&s);
+}
+
+static void test_scene_all_shapes_and_transform(void)
+{
+    const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    tu_write_file("tri.obj", obj);
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(
+        MIN_SCENE_HEAD
+        " \"lights\": [{\"centre\": [0, 5, 0], \"radius\": 0.5, \"flux\": 100}],\n"
+        " \"objects\": [\n"
+        "  {\"shape\": \"mesh\", \"file\": \"tri.obj\", \"material\": \"m\"},\n"
+        "  {\"shape\": \"box\", \"size\": [1, 2, 3], \"material\": \"m\",\n"
+        "   \"transform\": {\"translate\": [10, 0, 0], \"rotate\": [0, 90, 0], \"scale\": 2}},\n"
+        "  {\"shape\": \"prism\", \"material\": \"m\", \"depth\": 2},\n"
+        "  {\"shape\": \"quad\", \"material\": \"m\", \"size\": [4, 4]},\n"
+        "  {\"shape\": \"revolution\", \"material\": \"m\", \"segments\": 8,\n"
+        "   \"profile\": [[0, 0], [1, 0], [1, 1], [0, 1]]}]}",
+        &s, err, sizeof err);
+    CHECK(rc == 0, "all shapes load: %s", err);
+    if (rc) return;
+    CHECK(s.nobjects == 5, "5 objects, got %d", s.nobjects);
+    CHECK(s.objects[0].ntris == 1, "mesh has 1 triangle");
+    CHECK(s.objects[1].ntris == 12, "box has 12 triangles");
+    CHECK(s.objects[2].ntris == 8, "prism has 8 triangles");
+    CHECK(s.objects[3].ntris == 2, "quad has 2 triangles");
+    /* the box: size (1,2,3) scaled by 2, rotated 90 degrees about y (x<->z), moved to x=10 */
+    vec3 lo = v3(1e30f, 1e30f, 1e30f), hi = v3(-1e30f, -1e30f, -1e30f);
+    const SceneObject *b = &s.objects[1];
+    for (uint32_t t = b->first_tri; t < b->first_tri + b->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            vec3 p = s.mesh.verts[s.mesh.tris[3 * t + k]];
+            lo = v3_min(lo, p);
+            hi = v3_max(hi, p);
+        }
+    CHECK(fabsf(hi.x - lo.x - 6.0f) < 1e-4f && fabsf(hi.y - lo.y - 4.0f) < 1e-4f &&
+              fabsf(hi.z - lo.z - 2.0f) < 1e-4f,
+          "box extent after transform (%g %g %g)", hi.x - lo.x, hi.y - lo.y, hi.z - lo.z);
+    CHECK(fabsf((hi.x + lo.x) * 0.5f - 10.0f) < 1e-4f, "box centre x %g", (hi.x + lo.x) * 0.5f);
+    /* flux 100 from a sphere of radius 0.5: L = flux / (4 pi^2 r^2) */
+    float L = 100.0f / (4.0f * (float)(M_PI * M_PI) * 0.25f);
+    CHECK(fabsf(s.lights[0].radiance[0] - L) < 1e-3f * L, "light radiance %g, expected %g",
+          s.lights[0].radiance[0], L);
+    scene_free(&s);
+}
+
+static void test_scene_bad_syntax(void)
+{
+    expect_error("{\n  \"camera\": {\n    \"eye\": [0, 0 5]\n", "scene.json:3:", "syntax");
+    expect_error("", "scene.json:1:1", "end of file");
+    expect_error("{\"camera\": {}} trailing", "scene.json:1:", "syntax");
+}
+
+static void test_scene_unknown_keys(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": [], \"lihgts\": []}", "lihgts", "unknown key");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"transfrom\": {}}]}",
+                 "objects[0].transfrom", "unknown key");
+    expect_error(
+        "{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0], \"fov\": 30, \"fov\": 40}}",
+        "camera.fov", "twice");
+}
+
+static void test_scene_wrong_types(void)
+{
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0], \"fov\": \"wide\"}}",
+                 "camera.fov", "expected a number");
+    expect_error("{\"camera\": {\"eye\": [0, 0], \"look_at\": [0, 0, 0]}}", "camera.eye",
+                 "3 numbers");
+    expect_error("{\"camera\": {\"eye\": [0, 0, \"5\"], \"look_at\": [0, 0, 0]}}", "camera.eye[2]",
+                 "expected a number");
+    expect_error(MIN_SCENE_HEAD " \"objects\": {}}", "objects", "expected an array");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": 3}]}",
+                 "objects[0].material", "expected a string");
+}
+
+static void test_scene_unknown_names(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"shape\": \"sphere\", \"material\": \"glas\"}]}",
+                 "objects[2].material", "unknown material \"glas\"");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"torus\", \"material\": \"m\"}]}",
+                 "objects[0].shape", "unknown shape");
+}
+
+static void test_scene_out_of_range(void)
+{
+    expect_error(
+        "{\"image\": {\"width\": -4}, \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]}}",
+        "image.width", "out of range");
+    expect_error(
+        "{\"image\": {\"width\": 100.5}, \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]}}",
+        "image.width", "whole number");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"radius\": -1}]}",
+                 "objects[0].radius", "out of range");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"level\": 40}]}",
+                 "objects[0].level", "out of range");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"box\", \"material\": \"m\", "
+                                "\"transform\": {\"scale\": 0}}]}",
+                 "objects[0].transform.scale", "flattens");
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 5]}}", "camera.look_at",
+                 "must differ");
+    expect_error(MIN_SCENE_HEAD
+                 " \"lights\": [{\"centre\": [0, 0, 0], \"flux\": 1, \"intensity\": 2}], "
+                 "\"objects\": []}",
+                 "lights[0]", "exactly one");
+}
+
+static void test_scene_non_finite(void)
+{
+    expect_error("{\"camera\": {\"eye\": [0, 0, 1e999], \"look_at\": [0, 0, 0]}}", "camera.eye[2]",
+                 "finite");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"radius\": 1e999}]}",
+                 "objects[0].radius", "finite");
+    expect_error("{\"camera\": {\"eye\": [0, 0, NaN], \"look_at\": [0, 0, 0]}}",
+                 "scene.json:1:", "syntax");
+}
+
+static void test_scene_empty_and_missing(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": []}", "objects", "empty");
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]}, \"objects\": []}",
+                 "materials", "missing");
+    expect_error("{\"materials\": {\"m\": {}}, \"objects\": []}", "camera", "missing");
+    expect_error("[1, 2, 3]", "expected an object", NULL);
+}
+
+static void test_scene_bad_mesh_files(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"missing.obj\"}]}",
+                 "objects[0].file", "missing.obj");
+    tu_write_file("corrupt.obj", "v 0 0 0\nv 1 zero 0\nf 1 2 3\n");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"corrupt.obj\"}]}",
+                 "corrupt.obj:2", "objects[0].file");
+    tu_write_file("outofrange.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"outofrange.obj\"}]}",
+                 "outofrange.obj:4", "range");
+    tu_write_file("bad.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nend_header\n");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"bad.ply\"}]}",
+                 "bad.ply", "flaot");
+    tu_write_file("model.stl", "solid x\n");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"model.stl\"}]}",
+                 "model.stl", "stl");
+}
+
+static void test_scene_parse_grid(void)
+{
+    int r[3];
+    CHECK(scene_parse_grid("auto", r) == 0 && r[0] == 0, "auto");
+    CHECK(scene_parse_grid("20", r) == 0 && r[0] == 20 && r[1] == 20 && r[2] == 20, "N");
+    CHECK(scene_parse_grid("4,5,6", r) == 0 && r[0] == 4 && r[1] == 5 && r[2] == 6, "X,Y,Z");
+    CHECK(scene_parse_grid("4,5", r) == -1, "two values rejected");
+    CHECK(scene_parse_grid("0", r) == -1, "zero rejected");
+    CHECK(scene_parse_grid("5000", r) == -1, "too large rejected");
+    CHECK(scene_parse_grid("x", r) == -1, "text rejected");
+}
+
+void suite_scene(void)
+{
+    RUN_TEST(test_scene_minimal_defaults);
+    RUN_TEST(test_scene_all_shapes_and_transform);
+    RUN_TEST(test_scene_bad_syntax);
+    RUN_TEST(test_scene_unknown_keys);
+    RUN_TEST(test_scene_wrong_types);
+    RUN_TEST(test_scene_unknown_names);
+    RUN_TEST(test_scene_out_of_range);
+    RUN_TEST(test_scene_non_finite);
+    RUN_TEST(test_scene_empty_and_missing);
+    RUN_TEST(test_scene_bad_mesh_files);
+    RUN_TEST(test_scene_parse_grid);
+}

@@ -1,0 +1,34 @@
+/* testutil.h — what the test suites share: the vbcl binary under test, the OpenCL device
+ * (opened once), running commands, and temporary files. */
+#ifndef VBCL_TESTUTIL_H
+#define VBCL_TESTUTIL_H
+
+#include <stddef.h>
+
+#include "clu.h"
+
+/* Path of the vbcl binary the command-line tests run. */
+extern const char *tu_vbcl;
+
+/* The default OpenCL device, opened on first use; NULL (with a message) if none. */
+VbDevice *tu_device(void);
+
+/* Runs a shell command, capturing stdout and stderr together into out (may be NULL).
+ * Returns the exit status, or -1 if it could not run. */
+int tu_run(const char *cmd, char *out, size_t outlen);
+
+/* A fresh temporary directory for this test run (created once, removed at exit). */
+const char *tu_tmpdir(void);
+
+/* Writes text to dir/name and returns the full path in a static buffer ring. */
+const char *tu_write_file(const char *name, const char *text);
+
+/* Suites, one per test file. */
+void suite_mesh(void);
+void suite_grid_build(void);
+void suite_scene(void);
+void suite_cli(void);
+void suite_kernels(void);
+void suite_render(void);
+
+#endif
