@@ -52,8 +52,14 @@ build/config.mk: scripts/install-deps.sh
 deps:
 	scripts/install-deps.sh
 
+# ./vbcl is always the plain build; a sanitized one stays in build/san/vbcl.
+ifeq ($(SANITIZE),)
 vbcl: $(BUILD)/vbcl
 	$(Q)cp $< $@
+else
+vbcl: $(BUILD)/vbcl
+	@echo "sanitized binary: $(BUILD)/vbcl (./vbcl is left as the plain build)"
+endif
 
 $(BUILD)/vbcl: $(MAIN_OBJ) $(LIB_OBJ)
 	@echo "  LINK    $@"
