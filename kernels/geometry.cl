@@ -12,6 +12,14 @@
 
 #define VB_PI 3.14159265358979323846f
 
+/* Hot helpers must be inlined: on CPU drivers a call passes structs through the stack
+ * and every counter update becomes a store and a reload. */
+#ifdef __clang__
+#define VB_INLINE inline __attribute__((always_inline))
+#else
+#define VB_INLINE inline
+#endif
+
 inline float3 vb_load3(const float *p)
 {
     return (float3)(p[0], p[1], p[2]);
@@ -33,7 +41,7 @@ inline float vb_max3(float3 v)
 /* Moves a point p on a surface off it along the geometric normal n (pointing to the
  * side the new ray leaves into) by a few ulps of p's own magnitude, so a ray from the
  * result cannot hit the surface it starts on, at any scene scale. */
-inline float3 ray_offset_origin(float3 p, float3 n)
+VB_INLINE float3 ray_offset_origin(float3 p, float3 n)
 {
     const float origin = 1.0f / 32.0f;
     const float float_scale = 1.0f / 65536.0f;
@@ -46,47 +54,66 @@ inline float3 ray_offset_origin(float3 p, float3 n)
 }
 
 /* Per-ray constants of the watertight test: the axis permutation that makes the
- * largest direction component z, and the shear that maps the ray onto +z. */
+ * largest direction component z, and the shear that maps the ray onto +z, folded into
+ * three rows so that a vertex p maps to (dot(p, rx), dot(p, ry), dot(p, rz)). Each row
+ * holds 1 (or Sz) on one axis, -S on the z axis and 0 elsewhere; the sums are written
+ * out so that, with contraction off, every vertex maps identically in every triangle
+ * that shares it (what watertightness needs), without run-time shuffles. */
 typedef struct RayShear {
-    float4 org; /* w = 0 */
-    uint4 perm; /* (kx, ky, kz, 3) */
-    float sx, sy, sz;
+    float3 org;
+    float3 rx, ry, rz;
 } RayShear;
 
-inline RayShear ray_shear_make(float3 org, float3 dir)
+VB_INLINE float3 vb_axis(uint k)
+{
+    return (float3)(k == 0u ? 1.0f : 0.0f, k == 1u ? 1.0f : 0.0f, k == 2u ? 1.0f : 0.0f);
+}
+
+VB_INLINE float vb_comp(float3 v, uint k)
+{
+    return k == 0u ? v.x : (k == 1u ? v.y : v.z);
+}
+
+VB_INLINE RayShear ray_shear_make(float3 org, float3 dir)
 {
     RayShear r;
     float3 ad = fabs(dir);
     uint kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0u : 2u) : ((ad.y > ad.z) ? 1u : 2u);
     uint kx = kz == 2u ? 0u : kz + 1u;
     uint ky = kx == 2u ? 0u : kx + 1u;
-    float4 d = shuffle((float4)(dir, 0.0f), (uint4)(kx, ky, kz, 3u));
-    if (d.z < 0.0f) { /* keep the winding: swap x and y */
+    float dz = vb_comp(dir, kz);
+    if (dz < 0.0f) { /* keep the winding: swap x and y */
         uint t = kx;
         kx = ky;
         ky = t;
-        d = shuffle((float4)(dir, 0.0f), (uint4)(kx, ky, kz, 3u));
     }
-    r.org = (float4)(org, 0.0f);
-    r.perm = (uint4)(kx, ky, kz, 3u);
-    r.sx = d.x / d.z;
-    r.sy = d.y / d.z;
-    r.sz = 1.0f / d.z;
+    float sx = vb_comp(dir, kx) / dz, sy = vb_comp(dir, ky) / dz, sz = 1.0f / dz;
+    float3 ez = vb_axis(kz);
+    r.org = org;
+    r.rx = vb_axis(kx) - sx * ez;
+    r.ry = vb_axis(ky) - sy * ez;
+    r.rz = sz * ez;
     return r;
+}
+
+VB_INLINE float3 ray_shear_apply(const RayShear *r, float3 p)
+{
+    float3 q = p - r->org;
+    return (float3)(q.x * r->rx.x + q.y * r->rx.y + q.z * r->rx.z,
+                    q.x * r->ry.x + q.y * r->ry.y + q.z * r->ry.z,
+                    q.x * r->rz.x + q.y * r->rz.y + q.z * r->rz.z);
 }
 
 /* Intersects the sheared ray with triangle (a, b, c). On a hit with 0 < t < tmax
  * returns 1 and writes t and the barycentric weights of b (u) and c (v). Rays through
  * a shared edge or vertex of a closed mesh hit at least one of its triangles. */
-inline int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
-                         float *t_out, float *u_out, float *v_out)
+VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
+                            float *t_out, float *u_out, float *v_out)
 {
-    float4 A = shuffle(a4 - r->org, r->perm);
-    float4 B = shuffle(b4 - r->org, r->perm);
-    float4 C = shuffle(c4 - r->org, r->perm);
-    float ax = A.x - r->sx * A.z, ay = A.y - r->sy * A.z;
-    float bx = B.x - r->sx * B.z, by = B.y - r->sy * B.z;
-    float cx = C.x - r->sx * C.z, cy = C.y - r->sy * C.z;
+    float3 A = ray_shear_apply(r, a4.xyz);
+    float3 B = ray_shear_apply(r, b4.xyz);
+    float3 C = ray_shear_apply(r, c4.xyz);
+    float ax = A.x, ay = A.y, bx = B.x, by = B.y, cx = C.x, cy = C.y;
     float U = cx * by - cy * bx;
     float V = ax * cy - ay * cx;
     float W = bx * ay - by * ax;
@@ -100,8 +127,7 @@ inline int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, flo
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     float det = U + V + W;
     if (det == 0.0f) return 0;
-    float az = r->sz * A.z, bz = r->sz * B.z, cz = r->sz * C.z;
-    float T = U * az + V * bz + W * cz;
+    float T = U * A.z + V * B.z + W * C.z;
     if (det > 0.0f) {
         if (T <= 0.0f || T > tmax * det) return 0;
     } else {
@@ -114,7 +140,7 @@ inline int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, flo
     return 1;
 }
 
-inline float4 tri_vertex(__global const VbTriangle *tris, int tri, int k)
+VB_INLINE float4 tri_vertex(__global const VbTriangle *tris, int tri, int k)
 {
     __global const float *p = (__global const float *)(tris + tri) + 4 * k;
     return (float4)(p[0], p[1], p[2], 0.0f);

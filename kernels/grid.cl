@@ -20,8 +20,8 @@ typedef struct GridWalk {
 
 /* Clips the ray to the grid box and finds its first cell. Returns 0 when the ray misses
  * the grid or the part of it within (0, tmax]. */
-inline int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, float tmax,
-                           GridWalk *w)
+VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, float tmax,
+                              GridWalk *w)
 {
     float3 lo = vb_cload3(g->lo), hi = vb_cload3(g->hi);
     float3 inv = (float3)(1.0f) / dir; /* +-inf for zero components */
@@ -50,7 +50,7 @@ inline int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, f
 }
 
 /* Steps to the next cell; returns 0 when the ray leaves the grid or passes t_leave. */
-inline int grid_walk_next(__constant const VbGrid *g, GridWalk *w)
+VB_INLINE int grid_walk_next(__constant const VbGrid *g, GridWalk *w)
 {
     float3 tn = w->t_next;
     if (tn.x < tn.y && tn.x < tn.z) {
@@ -71,7 +71,7 @@ inline int grid_walk_next(__constant const VbGrid *g, GridWalk *w)
     return w->cell.z >= 0 && w->cell.z < g->n[2];
 }
 
-inline int grid_cell_index(__constant const VbGrid *g, int3 c)
+VB_INLINE int grid_cell_index(__constant const VbGrid *g, int3 c)
 {
     return c.x + g->n[0] * (c.y + g->n[1] * c.z);
 }
@@ -79,9 +79,9 @@ inline int grid_cell_index(__constant const VbGrid *g, int3 c)
 /* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell is
  * accepted only if it lies before the cell's exit, so a triangle that also spans later
  * cells cannot hide a closer one there. Ties go to the lower triangle index. */
-inline VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
-                                __global const uint *cell_start, __global const uint *cell_tris,
-                                float3 org, float3 dir, float tmax, TraceCount *count)
+VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
+                                   __global const uint *cell_start, __global const uint *cell_tris,
+                                   float3 org, float3 dir, float tmax, TraceCount *count)
 {
     VbHit hit;
     hit.t = tmax;
@@ -90,14 +90,15 @@ inline VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTri
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return hit;
     RayShear rs = ray_shear_make(org, dir);
+    uint steps = 0, tests = 0;
     do {
-        count->steps++;
+        steps++;
         int ci = grid_cell_index(g, w.cell);
-        uint end = cell_start[ci + 1];
-        for (uint k = cell_start[ci]; k < end; k++) {
+        uint begin = cell_start[ci], end = cell_start[ci + 1];
+        tests += end - begin;
+        for (uint k = begin; k < end; k++) {
             int tri = (int)cell_tris[k];
             float t, u, v;
-            count->tests++;
             if (tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
                               tri_vertex(tris, tri, 2), hit.t, &t, &u, &v)) {
                 if (hit.tri < 0 || t < hit.t || (t == hit.t && tri < hit.tri)) {
@@ -109,32 +110,37 @@ inline VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTri
             }
         }
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
-        if (hit.tri >= 0 && hit.t <= cell_exit) return hit;
+        if (hit.tri >= 0 && hit.t <= cell_exit) break;
     } while (grid_walk_next(g, &w));
+    count->steps += steps;
+    count->tests += tests;
     return hit;
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow
  * feeler: the first occluder ends the walk). */
-inline int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
-                          __global const uint *cell_start, __global const uint *cell_tris,
-                          float3 org, float3 dir, float tmax, TraceCount *count)
+VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
+                             __global const uint *cell_start, __global const uint *cell_tris,
+                             float3 org, float3 dir, float tmax, TraceCount *count)
 {
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return 0;
     RayShear rs = ray_shear_make(org, dir);
+    uint steps = 0, tests = 0;
+    int blocked = 0;
     do {
-        count->steps++;
+        steps++;
         int ci = grid_cell_index(g, w.cell);
-        uint end = cell_start[ci + 1];
-        for (uint k = cell_start[ci]; k < end; k++) {
+        uint begin = cell_start[ci], end = cell_start[ci + 1];
+        for (uint k = begin; k < end && !blocked; k++) {
             int tri = (int)cell_tris[k];
             float t, u, v;
-            count->tests++;
-            if (tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                              tri_vertex(tris, tri, 2), tmax, &t, &u, &v))
-                return 1;
+            tests++;
+            blocked = tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                                    tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
         }
-    } while (grid_walk_next(g, &w));
-    return 0;
+    } while (!blocked && grid_walk_next(g, &w));
+    count->steps += steps;
+    count->tests += tests;
+    return blocked;
 }

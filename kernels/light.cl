@@ -3,7 +3,7 @@
  * spherical lights, with shadow feelers to stratified points on the visible cap. */
 
 /* Integer hash (lowbias32): decorrelated jitter from a pixel, light and stratum. */
-inline uint vb_hash(uint x)
+VB_INLINE uint vb_hash(uint x)
 {
     x ^= x >> 16;
     x *= 0x7feb352du;
@@ -13,14 +13,14 @@ inline uint vb_hash(uint x)
     return x;
 }
 
-inline float vb_unit_float(uint h)
+VB_INLINE float vb_unit_float(uint h)
 {
     return (float)(h >> 8) * (1.0f / 16777216.0f);
 }
 
 /* Solid angle of the cap of a sphere of radius r seen from distance d > r:
  * 2 pi (1 - cos theta_max), with sin theta_max = r / d. */
-inline float light_cap_solid_angle(float r, float d)
+VB_INLINE float light_cap_solid_angle(float r, float d)
 {
     float s2 = (r * r) / (d * d);
     /* 1 - sqrt(1 - s2) without cancellation for small caps */
@@ -28,7 +28,7 @@ inline float light_cap_solid_angle(float r, float d)
 }
 
 /* Two unit vectors completing w to an orthonormal frame (Duff et al. 2017). */
-inline void vb_frame(float3 w, float3 *t, float3 *b)
+VB_INLINE void vb_frame(float3 w, float3 *t, float3 *b)
 {
     float s = copysign(1.0f, w.z);
     float a = -1.0f / (s + w.z);
@@ -57,10 +57,10 @@ typedef struct ShadowCount {
  * the point is sampled at strata^2 stratified directions; each direction's feeler is
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
  * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
-inline float3 light_reflect_one(__constant const VbFrame *f, __global const VbTriangle *tris,
-                                __global const uint *cell_start, __global const uint *cell_tris,
-                                __global const VbLight *light, __global const VbMaterial *m,
-                                const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
+VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const VbTriangle *tris,
+                                   __global const uint *cell_start, __global const uint *cell_tris,
+                                   __global const VbLight *light, __global const VbMaterial *m,
+                                   const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
 {
     float3 c = vb_gload3(light->centre);
     float3 radiance = vb_gload3(light->radiance);
@@ -72,6 +72,8 @@ inline float3 light_reflect_one(__constant const VbFrame *f, __global const VbTr
 #ifdef VBCL_HAS_SPECULAR
     float3 ks = vb_gload3(m->specular);
     float spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
+    /* (N.H)^n < 1e-4 below this cosine: such samples skip the costly pow */
+    float nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
 #endif
     float3 origin = ray_offset_origin(sp->p, sp->ng);
     uint strata = f->shadow_strata;
@@ -121,7 +123,8 @@ inline float3 light_reflect_one(__constant const VbFrame *f, __global const VbTr
                 sum_cos += cos_n;
 #ifdef VBCL_HAS_SPECULAR
                 float3 hv = normalize(w + sp->wo);
-                sum_s += pow(fmax(0.0f, dot(sp->ns, hv)), m->exponent) * cos_n;
+                float nh = dot(sp->ns, hv);
+                if (nh > nh_min) sum_s += powr(nh, m->exponent) * cos_n;
 #endif
             }
         }
@@ -146,18 +149,19 @@ inline float3 light_reflect_one(__constant const VbFrame *f, __global const VbTr
     float3 brdf = kd;
 #ifdef VBCL_HAS_SPECULAR
     float3 hv = normalize(w + sp->wo);
-    brdf += ks * (spec_norm * pow(fmax(0.0f, dot(sp->ns, hv)), m->exponent));
+    float nh = dot(sp->ns, hv);
+    if (nh > nh_min) brdf += ks * (spec_norm * powr(nh, m->exponent));
 #endif
     return radiance * brdf * (cos_n / d2);
 }
 
 /* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):
  * k_local * (ambient + sum over lights of diffuse + specular). */
-inline float3 light_shade_local(__constant const VbFrame *f, __global const VbTriangle *tris,
-                                __global const uint *cell_start, __global const uint *cell_tris,
-                                __global const VbMaterial *materials,
-                                __global const VbLight *lights, const ShadePoint *sp,
-                                TraceCount *tc, ShadowCount *sc)
+VB_INLINE float3 light_shade_local(__constant const VbFrame *f, __global const VbTriangle *tris,
+                                   __global const uint *cell_start, __global const uint *cell_tris,
+                                   __global const VbMaterial *materials,
+                                   __global const VbLight *lights, const ShadePoint *sp,
+                                   TraceCount *tc, ShadowCount *sc)
 {
     __global const VbMaterial *m = materials + sp->material;
     float3 col = vb_gload3(m->ambient) * vb_cload3(f->ambient);
