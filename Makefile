@@ -35,7 +35,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean
+.PHONY: all run test deps format format-check clean bench-grid
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -105,6 +105,10 @@ run: vbcl
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0)
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
+
+# Render time against the auto-grid density (docs/architecture.md, "Measurements").
+bench-grid: vbcl
+	scripts/bench_grid.sh
 
 FORMAT_FILES := $(wildcard host/*.c host/*.h host/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h scripts/*.c)
 format:

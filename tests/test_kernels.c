@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "render.h"
@@ -380,8 +381,52 @@ static void test_rays_at_edges_and_vertices_hit(void)
     fixture_close(&fx);
 }
 
+/* A kernel that does not compile: NULL, the error recorded, and the build log and the
+ * options printed on stderr. */
+static void test_failed_build_prints_log_and_options(void)
+{
+    VbDevice *d = tu_device();
+    if (!d) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/build-log.txt", tu_tmpdir());
+    fflush(stderr);
+    int saved = dup(2);
+    FILE *f = fopen(path, "w");
+    if (!f || saved < 0) {
+        CHECK(0, "cannot redirect stderr");
+        return;
+    }
+    dup2(fileno(f), 2);
+    double ms;
+    int cached;
+    clu_error_clear();
+    cl_program p = clu_program_build(d, "__kernel void broken(__global float *x) { x[0] = y; }\n",
+                                     "-DVBCL_MARKER_OPTION", &ms, &cached);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    fclose(f);
+    CHECK(p == NULL, "a broken kernel must not build");
+    if (p) clReleaseProgram(p);
+    CHECK(strstr(clu_error(), "CL_BUILD_PROGRAM_FAILURE") != NULL, "error recorded: %s", clu_error());
+    char log[8192] = "";
+    f = fopen(path, "r");
+    if (f) {
+        size_t n = fread(log, 1, sizeof log - 1, f);
+        log[n] = 0;
+        fclose(f);
+    }
+    CHECK(strstr(log, "-DVBCL_MARKER_OPTION") != NULL, "options printed: %s", log);
+    CHECK(strstr(log, "build log") != NULL && strstr(log, "y") != NULL, "log printed: %s", log);
+    clu_error_clear();
+}
+
 void suite_kernels(void)
 {
+    RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
     RUN_TEST(test_light_irradiance_closed_form);

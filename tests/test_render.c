@@ -110,8 +110,75 @@ static void test_render_quickstart_reference(void)
     CHECK(rc == 0 || rc == 1, "idiff against the reference (exit %d): %s", rc, log);
 }
 
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    return buf;
+}
+
+/* Writes the quickstart scene with one text replacement into the temporary directory. */
+static const char *quickstart_variant(const char *name, const char *from, const char *to)
+{
+    const char *text = read_text("scenes/quickstart.json");
+    static char out[1 << 16];
+    const char *at = text ? strstr(text, from) : NULL;
+    CHECK(at != NULL, "quickstart.json contains %s", from);
+    if (!at) return NULL;
+    snprintf(out, sizeof out, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    return tu_write_file(name, out);
+}
+
+/* The quickstart's spherical light casts soft shadows: against a point light of the same
+ * intensity (the same irradiance wherever the light is unoccluded, by the closed form
+ * E = I cos / d^2), lit pixels agree, and along shadow edges pixels lie strictly between
+ * the ambient-only value and the lit value. */
+static void test_render_quickstart_soft_shadow(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *names[3] = {"soft", "hard", "ambient"};
+    const char *scenes[3] = {"scenes/quickstart.json",
+                             quickstart_variant("qs_hard.json", "\"radius\": 0.9", "\"radius\": 0"),
+                             quickstart_variant("qs_ambient.json", "\"flux\": 3000", "\"flux\": 1e-30")};
+    float *img[3] = {NULL, NULL, NULL};
+    int w = 0, h = 0;
+    for (int i = 0; i < 3; i++) {
+        char out[512], err[512];
+        if (!scenes[i]) return;
+        snprintf(out, sizeof out, "%s/qs_%s.exr", tu_tmpdir(), names[i]);
+        if (render(scenes[i], out, "--width 100 --height 100 --shadow-samples 64")) return;
+        if (image_read(out, &w, &h, &img[i], err, sizeof err)) {
+            CHECK(0, "%s", err);
+            return;
+        }
+    }
+    int lit = 0, agree = 0, between = 0;
+    for (int i = 0; i < w * h; i++) {
+        double s = img[0][4 * i + 1], p = img[1][4 * i + 1], a = img[2][4 * i + 1];
+        if (p - a < 0.05) continue; /* in the point light's shadow, or barely lit */
+        lit++;
+        double f = (s - a) / (p - a); /* visible fraction of the spherical light */
+        agree += fabs(f - 1.0) < 0.05;
+        between += f > 0.1 && f < 0.9;
+    }
+    fprintf(stderr, "    %d pixels lit by the point light: %d agree with the sphere light within 5%%, "
+                    "%d see 10%%..90%% of the sphere (penumbra)\n", lit, agree, between);
+    CHECK(lit > 1000, "most of the image is lit (%d)", lit);
+    CHECK(agree > 0.8 * lit, "unoccluded sphere light equals the point light (%d of %d)", agree, lit);
+    CHECK(between >= 30, "a soft shadow: %d penumbra pixels strictly between lit and dark", between);
+    for (int i = 0; i < 3; i++) free(img[i]);
+}
+
 void suite_render(void)
 {
+    RUN_TEST(test_render_quickstart_soft_shadow);
     RUN_TEST(test_render_penumbra_matches_geometry);
     RUN_TEST(test_render_quickstart_reference);
 }
