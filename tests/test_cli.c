@@ -1,10 +1,13 @@
 /* test_cli.c — the vbcl binary as a user meets it: help, devices, options, and bad input
  * of every class giving exit 2, a one-line message, and no output file touched. */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "harness.h"
+#include "image_io.h"
 #include "testutil.h"
 
 #define GOOD_SCENE                                                                                 \
@@ -66,6 +69,32 @@ static void test_cli_renders_and_overrides(void)
     CHECK(strstr(out, "4x4x4") != NULL, "command line overrides the grid: %s", out);
     CHECK(strstr(out, "rays        primary 200") != NULL, "--stats counts primary rays: %s", out);
     CHECK(file_exists(img), "image written");
+    /* every output format, read back: 8-bit sRGB ones and linear float EXR agree */
+    const char *exts[] = {"png", "jpg", "tif", "exr"};
+    float *pix[4] = {NULL, NULL, NULL, NULL};
+    for (int i = 0; i < 4; i++) {
+        char path[512], err[512];
+        int w = 0, h = 0;
+        snprintf(path, sizeof path, "%s/fmt.%s", tu_tmpdir(), exts[i]);
+        snprintf(args, sizeof args, "%s -q -o %s --width 12 --height 8", scene, path);
+        CHECK(vbcl(args, out, sizeof out) == 0, "writes .%s: %s", exts[i], out);
+        CHECK(image_read(path, &w, &h, &pix[i], err, sizeof err) == 0 && w == 12 && h == 8,
+              ".%s reads back as 12x8: %s", exts[i], err);
+    }
+    if (pix[0] && pix[1] && pix[2] && pix[3]) {
+        double worst_png = 0, worst_jpg = 0;
+        for (int k = 0; k < 12 * 8 * 4; k++) {
+            if (k % 4 == 3) continue;
+            double lin = pix[3][k] <= 0 ? 0 : pix[3][k] >= 1 ? 1 : pix[3][k];
+            double enc = lin <= 0.0031308 ? 12.92 * lin : 1.055 * pow(lin, 1 / 2.4) - 0.055;
+            worst_png = fmax(worst_png, fmax(fabs(pix[0][k] - enc), fabs(pix[2][k] - enc)));
+            worst_jpg = fmax(worst_jpg, fabs(pix[1][k] - enc));
+        }
+        CHECK(worst_png <= 0.5 / 255 + 1e-6, "PNG and TIFF are the EXR, sRGB-encoded (worst %g)",
+              worst_png);
+        CHECK(worst_jpg <= 0.15, "JPEG close to the EXR (worst %g)", worst_jpg);
+    }
+    for (int i = 0; i < 4; i++) free(pix[i]);
     /* from another working directory: kernels are embedded, mesh paths are scene-relative */
     snprintf(args, sizeof args, "cd / && %s%s -q %s -o %s/good.png",
              tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, scene, tu_tmpdir());
