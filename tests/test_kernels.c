@@ -411,7 +411,8 @@ static void test_failed_build_prints_log_and_options(void)
     fclose(f);
     CHECK(p == NULL, "a broken kernel must not build");
     if (p) clReleaseProgram(p);
-    CHECK(strstr(clu_error(), "CL_BUILD_PROGRAM_FAILURE") != NULL, "error recorded: %s", clu_error());
+    CHECK(strstr(clu_error(), "CL_BUILD_PROGRAM_FAILURE") != NULL, "error recorded: %s",
+          clu_error());
     char log[8192] = "";
     f = fopen(path, "r");
     if (f) {

@@ -144,9 +144,10 @@ static void test_render_quickstart_soft_shadow(void)
         return;
     }
     const char *names[3] = {"soft", "hard", "ambient"};
-    const char *scenes[3] = {"scenes/quickstart.json",
-                             quickstart_variant("qs_hard.json", "\"radius\": 0.9", "\"radius\": 0"),
-                             quickstart_variant("qs_ambient.json", "\"flux\": 3000", "\"flux\": 1e-30")};
+    const char *scenes[3] = {
+        "scenes/quickstart.json",
+        quickstart_variant("qs_hard.json", "\"radius\": 0.9", "\"radius\": 0"),
+        quickstart_variant("qs_ambient.json", "\"flux\": 3000", "\"flux\": 1e-30")};
     float *img[3] = {NULL, NULL, NULL};
     int w = 0, h = 0;
     for (int i = 0; i < 3; i++) {
@@ -168,11 +169,15 @@ static void test_render_quickstart_soft_shadow(void)
         agree += fabs(f - 1.0) < 0.05;
         between += f > 0.1 && f < 0.9;
     }
-    fprintf(stderr, "    %d pixels lit by the point light: %d agree with the sphere light within 5%%, "
-                    "%d see 10%%..90%% of the sphere (penumbra)\n", lit, agree, between);
+    fprintf(stderr,
+            "    %d pixels lit by the point light: %d agree with the sphere light within 5%%, "
+            "%d see 10%%..90%% of the sphere (penumbra)\n",
+            lit, agree, between);
     CHECK(lit > 1000, "most of the image is lit (%d)", lit);
-    CHECK(agree > 0.8 * lit, "unoccluded sphere light equals the point light (%d of %d)", agree, lit);
-    CHECK(between >= 30, "a soft shadow: %d penumbra pixels strictly between lit and dark", between);
+    CHECK(agree > 0.8 * lit, "unoccluded sphere light equals the point light (%d of %d)", agree,
+          lit);
+    CHECK(between >= 30, "a soft shadow: %d penumbra pixels strictly between lit and dark",
+          between);
     for (int i = 0; i < 3; i++) free(img[i]);
 }
 
