@@ -14,6 +14,7 @@
 #include "image_io.h"
 #include "render.h"
 #include "scene.h"
+#include "texgen.h"
 
 #define VBCL_VERSION "0.1.0"
 
@@ -215,6 +216,7 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
     double t0 = clu_now_ms();
     Options o;
     int rc = parse_args(argc, argv, &o);

@@ -97,6 +97,7 @@ int main(int argc, char **argv)
     suite_mesh();
     suite_grid_build();
     suite_scene();
+    suite_texgen();
     suite_cli();
     suite_kernels();
     suite_render();

@@ -27,6 +27,7 @@ const char *tu_write_file(const char *name, const char *text);
 void suite_mesh(void);
 void suite_grid_build(void);
 void suite_scene(void);
+void suite_texgen(void);
 void suite_cli(void);
 void suite_kernels(void);
 void suite_render(void);
