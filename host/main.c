@@ -32,6 +32,9 @@ static const char usage_text[] =
     "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto)\n"
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
+    "      --depth N            maximum depth of the ray tree (1..64)\n"
+    "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
+    "      --fresnel exact|thesis  energy split at interfaces: Fresnel, or thesis eq. 9\n"
     "      --exposure STOPS     scale the image by 2^STOPS before writing\n"
     "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
@@ -47,9 +50,9 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid;
-    int width, height, shadow_samples;
-    double grid_density, exposure;
+    const char *scene, *output, *device, *grid, *fresnel;
+    int width, height, shadow_samples, depth;
+    double grid_density, exposure, min_weight;
     int have_exposure;
     int list_devices, stats, quiet;
 } Options;
@@ -97,8 +100,8 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
 static int parse_args(int argc, char **argv, Options *o)
 {
     memset(o, 0, sizeof *o);
-    o->width = o->height = o->shadow_samples = -1;
-    o->grid_density = -1;
+    o->width = o->height = o->shadow_samples = o->depth = -1;
+    o->grid_density = o->min_weight = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -131,6 +134,17 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "--shadow-samples")) {
             NEEDS_VALUE;
             if (parse_int(a, val, 1, 1024, &o->shadow_samples)) return 2;
+        } else if (!strcmp(a, "--depth")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, 64, &o->depth)) return 2;
+        } else if (!strcmp(a, "--min-weight")) {
+            NEEDS_VALUE;
+            if (parse_double(a, val, 0, 1, &o->min_weight)) return 2;
+        } else if (!strcmp(a, "--fresnel")) {
+            NEEDS_VALUE;
+            if (strcmp(val, "exact") && strcmp(val, "thesis"))
+                return usage_error("--fresnel %s: expected exact or thesis", val);
+            o->fresnel = val;
         } else if (!strcmp(a, "--exposure")) {
             NEEDS_VALUE;
             if (parse_double(a, val, -30, 30, &o->exposure)) return 2;
@@ -180,8 +194,8 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
 {
     char feat[128];
     features_describe(st->features, feat, sizeof feat);
-    unsigned long long rays = st->rays_primary + st->rays_shadow;
-    double kernel_ms = st->camera_ms + st->intersect_ms + st->shading_ms;
+    unsigned long long rays = st->rays_primary + st->rays_shadow + st->reflected + st->transmitted;
+    double kernel_ms = st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms;
     unsigned strata = r->frame_host.shadow_strata;
     fprintf(stderr, "scene       %s: %d objects, %u triangles, %d materials, %d lights\n", s->path,
             s->nobjects, s->mesh.ntris, s->nmaterials, s->nlights);
@@ -200,6 +214,25 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
             "rays        primary %llu, shadow %llu (%u per light per point; %llu skipped: light "
             "behind the surface), total %llu\n",
             st->rays_primary, st->rays_shadow, strata * strata, st->shadow_skipped, rays);
+    if (st->features & VBCL_FEATURE_TRANSPARENCY) {
+        fprintf(
+            stderr,
+            "ray tree    reflected %llu, transmitted %llu, total internal reflections %llu; not "
+            "traced: %llu pruned (weight < %g), %llu deeper than max depth %d\n",
+            st->reflected, st->transmitted, st->tir, st->pruned, (double)s->min_weight,
+            st->depth_cut, s->max_depth);
+        fprintf(stderr, "energy      %llu interfaces split, %llu with |R + T - 1| > 1e-5\n",
+                st->interfaces, st->energy_errors);
+        fprintf(stderr, "by depth   ");
+        for (int k = 0; k < VBCL_COUNT_DEPTH_BINS; k++)
+            if (st->by_depth[k])
+                fprintf(stderr, " %s%d: %llu", k == VBCL_COUNT_DEPTH_BINS - 1 ? ">=" : "", k,
+                        st->by_depth[k]);
+        fputc('\n', stderr);
+    }
+    if (st->features & (VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_TEXTURES))
+        fprintf(stderr, "media       %llu crossings passed through (no change of material)\n",
+                st->pass_through);
     fprintf(stderr, "work        %.2f cells visited and %.2f triangles tested per ray\n",
             rays ? (double)st->traversal_steps / (double)rays : 0.0,
             rays ? (double)st->tri_tests / (double)rays : 0.0);
@@ -207,9 +240,10 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
     fprintf(
         stderr,
         "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f ms, "
-        "readback %.1f ms (device) | render %.1f ms, write %.1f ms, total %.1f ms (wall)\n",
-        st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->readback_ms,
-        st->render_ms, write_ms, total_ms);
+        "ray trees %.1f ms, readback %.1f ms (device) | render %.1f ms, write %.1f ms, total %.1f "
+        "ms (wall)\n",
+        st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->tree_ms,
+        st->readback_ms, st->render_ms, write_ms, total_ms);
     fprintf(stderr, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
             kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
 }
@@ -234,6 +268,10 @@ int main(int argc, char **argv)
     if (o.shadow_samples > 0) s.shadow_samples = o.shadow_samples;
     if (o.grid_density > 0) s.grid_density = (float)o.grid_density;
     if (o.have_exposure) s.exposure = (float)o.exposure;
+    if (o.depth > 0) s.max_depth = o.depth;
+    if (o.min_weight >= 0) s.min_weight = (float)o.min_weight;
+    if (o.fresnel)
+        s.fresnel = strcmp(o.fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o.grid && scene_parse_grid(o.grid, s.grid_res)) {
         scene_free(&s);
         return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o.grid);
@@ -286,7 +324,7 @@ int main(int argc, char **argv)
     double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
     if (o.stats) print_stats(&s, &dev, &r, &st, write_ms, total_ms);
     if (!o.quiet) {
-        unsigned long long rays = st.rays_primary + st.rays_shadow;
+        unsigned long long rays = st.rays_primary + st.rays_shadow + st.reflected + st.transmitted;
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s.width, s.height, total_ms / 1000.0, s.mesh.ntris, rays,
                st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev.name);

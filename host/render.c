@@ -42,7 +42,7 @@ static void frame_grid(const Grid *g, VbGrid *out)
     }
 }
 
-/* Triangles as the kernels read them, material index in the w of the first vertex. */
+/* Triangles as the kernels read them, the tag in the w of the first vertex. */
 static VbTriangle *pack_triangles(const Scene *s)
 {
     const Mesh *m = &s->mesh;
@@ -56,7 +56,7 @@ static VbTriangle *pack_triangles(const Scene *s)
             dst[k][1] = p.y;
             dst[k][2] = p.z;
         }
-        memcpy(&t[i].v0[3], &s->tri_material[i], sizeof(uint32_t));
+        memcpy(&t[i].v0[3], &s->tri_tag[i], sizeof(uint32_t));
     }
     return t;
 }
@@ -96,16 +96,32 @@ static cl_mem upload(VbDevice *d, const void *data, size_t bytes, cl_mem_flags f
     return m;
 }
 
-static int set_args(cl_kernel k, int n, const size_t *sizes, const void *const *vals)
+static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
 {
-    for (int i = 0; i < n; i++) {
-        cl_int rc = clSetKernelArg(k, (cl_uint)i, sizes[i], vals[i]);
-        if (rc != CL_SUCCESS) {
-            char what[64];
-            snprintf(what, sizeof what, "clSetKernelArg(argument %d)", i);
-            return clu_fail(rc, what, __FILE__, __LINE__);
-        }
-    }
+    cl_int rc = clSetKernelArg(k, i, size, val);
+    if (rc == CL_SUCCESS) return 0;
+    char what[64];
+    snprintf(what, sizeof what, "clSetKernelArg(argument %u)", i);
+    return clu_fail(rc, what, __FILE__, __LINE__);
+}
+
+int renderer_set_scene_args(const Renderer *r, cl_kernel k)
+{
+    const cl_mem *m[8] = {&r->frame,     &r->tris,      &r->normals, &r->cell_start,
+                          &r->cell_tris, &r->materials, &r->objects, &r->lights};
+    for (cl_uint i = 0; i < 8; i++)
+        if (set_arg(k, i, sizeof(cl_mem), m[i])) return -1;
+    return 0;
+}
+
+int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nrays, cl_mem hits,
+                            cl_mem media, cl_mem radiance, cl_mem counters)
+{
+    if (renderer_set_scene_args(r, k) || set_arg(k, 8, sizeof(cl_mem), &rays) ||
+        set_arg(k, 9, sizeof(int), &nrays) || set_arg(k, 10, sizeof(cl_mem), &hits) ||
+        set_arg(k, 11, sizeof(cl_mem), &media) || set_arg(k, 12, sizeof(cl_mem), &radiance) ||
+        set_arg(k, 13, sizeof(cl_mem), &counters))
+        return -1;
     return 0;
 }
 
@@ -136,6 +152,10 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     CL_CHECK_ERR(rc, "clCreateKernel(scene_intersect_closest)", fail);
     r->k_shading = clCreateKernel(r->program, "light_sample_shading", &rc);
     CL_CHECK_ERR(rc, "clCreateKernel(light_sample_shading)", fail);
+    if (r->features & VBCL_FEATURE_TRANSPARENCY) {
+        r->k_tree = clCreateKernel(r->program, "tree_trace_secondary", &rc);
+        CL_CHECK_ERR(rc, "clCreateKernel(tree_trace_secondary)", fail);
+    }
 
     double t0 = clu_now_ms();
     VbTriangle *tris = pack_triangles(s);
@@ -170,13 +190,31 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
         upload(dev, r->grid.cell_start, sizeof(uint32_t) * (r->grid.ncells + 1u), CL_MEM_READ_ONLY);
     r->cell_tris =
         upload(dev, r->grid.cell_tris, sizeof(uint32_t) * r->grid.nrefs, CL_MEM_READ_ONLY);
-    VbMaterial *mats = calloc((size_t)s->nmaterials, sizeof *mats);
-    if (!mats) goto fail;
+    /* the scene's materials, then the medium outside every host: vacuum, eta 1 */
+    VbMaterial *mats = calloc((size_t)s->nmaterials + 1, sizeof *mats);
+    VbObject *objs = calloc((size_t)s->nobjects, sizeof *objs);
+    if (!mats || !objs) {
+        free(mats);
+        free(objs);
+        goto fail;
+    }
     for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
-    r->materials = upload(dev, mats, sizeof *mats * (size_t)s->nmaterials, CL_MEM_READ_ONLY);
+    mats[s->nmaterials].eta = 1.0f;
+    mats[s->nmaterials].k_global = 1.0f;
+    for (int i = 0; i < s->nobjects; i++) {
+        const SceneObject *o = &s->objects[i];
+        objs[i].material = (unsigned)o->material;
+        objs[i].tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
+        objs[i].tex_slot = o->tex_slot;
+        objs[i].flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
+    }
+    r->materials = upload(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
+    r->objects = upload(dev, objs, sizeof *objs * (size_t)s->nobjects, CL_MEM_READ_ONLY);
     free(mats);
+    free(objs);
     r->lights = upload(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
-    if (!r->tris || !r->normals || !r->cell_start || !r->cell_tris || !r->materials || !r->lights)
+    if (!r->tris || !r->normals || !r->cell_start || !r->cell_tris || !r->materials ||
+        !r->objects || !r->lights)
         goto fail;
 
     /* frame constants */
@@ -193,6 +231,10 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
     f->shadow_strata = strata < 1 ? 1 : strata;
     f->seed = s->seed;
+    scene_medium_at(s, s->eye, &f->camera_medium);
+    f->air_material = (unsigned)s->nmaterials;
+    f->min_weight = s->min_weight;
+    f->max_depth = s->max_depth;
     r->frame = upload(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
 
     /* tiles: bounded so that 32-bit work counters of one tile cannot overflow */
@@ -204,9 +246,10 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     r->tile_pixels = (int)tile;
     r->rays = upload(dev, NULL, sizeof(VbRay) * (size_t)tile, CL_MEM_READ_WRITE);
     r->hits = upload(dev, NULL, sizeof(VbHit) * (size_t)tile, CL_MEM_READ_WRITE);
-    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)tile, CL_MEM_WRITE_ONLY);
+    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)tile, CL_MEM_READ_WRITE);
+    r->media = upload(dev, NULL, sizeof(VbMedium) * (size_t)tile, CL_MEM_READ_WRITE);
     r->counters = upload(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
-    if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->counters) goto fail;
+    if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->media || !r->counters) goto fail;
     st->upload_ms = clu_now_ms() - t0;
     st->tile_pixels = r->tile_pixels;
     return 0;
@@ -244,7 +287,7 @@ int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, i
         int n = (int)((npix - first) < r->tile_pixels ? (npix - first) : r->tile_pixels);
         f->first_pixel = (int)first;
         f->tile_pixels = n;
-        cl_event ev[4] = {0};
+        cl_event ev[5] = {0};
         cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
         size_t global = ((size_t)n + 63) / 64 * 64;
         CL_CHECK(clEnqueueWriteBuffer(d->queue, r->frame, CL_FALSE, 0, sizeof *f, f, 0, NULL, NULL),
@@ -252,39 +295,19 @@ int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, i
         CL_CHECK(clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0,
                                       NULL, NULL),
                  fail);
-        {
-            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem)};
-            const void *v[] = {&r->frame, &r->rays};
-            if (set_args(r->k_camera, 2, sz, v)) goto fail;
+        /* camera rays, first interfaces, local shading, and with dielectrics the ray trees */
+        cl_kernel stages[4] = {r->k_camera, r->k_intersect, r->k_shading, r->k_tree};
+        for (int k = 0; k < 4; k++) {
+            if (!stages[k]) continue;
+            if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
+                                        r->counters))
+                goto fail;
+            CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global, NULL, 0, NULL,
+                                            &ev[k]),
+                     fail);
         }
-        CL_CHECK(
-            clEnqueueNDRangeKernel(d->queue, r->k_camera, 1, NULL, &global, NULL, 0, NULL, &ev[0]),
-            fail);
-        {
-            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                                 sizeof(cl_mem), sizeof(cl_int), sizeof(cl_mem), sizeof(cl_mem)};
-            const void *v[] = {&r->frame, &r->tris, &r->cell_start, &r->cell_tris,
-                               &r->rays,  &n,       &r->hits,       &r->counters};
-            if (set_args(r->k_intersect, 8, sz, v)) goto fail;
-        }
-        CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_intersect, 1, NULL, &global, NULL, 0, NULL,
-                                        &ev[1]),
-                 fail);
-        {
-            const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                                 sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                                 sizeof(cl_mem), sizeof(cl_int), sizeof(cl_mem), sizeof(cl_mem)};
-            const void *v[] = {
-                &r->frame,     &r->tris,    &r->normals, &r->cell_start, &r->cell_tris,
-                &r->materials, &r->lights,  &r->rays,    &r->hits,       &n,
-                &r->radiance,  &r->counters};
-            if (set_args(r->k_shading, 12, sz, v)) goto fail;
-        }
-        CL_CHECK(
-            clEnqueueNDRangeKernel(d->queue, r->k_shading, 1, NULL, &global, NULL, 0, NULL, &ev[2]),
-            fail);
         CL_CHECK(clEnqueueReadBuffer(d->queue, r->radiance, CL_FALSE, 0,
-                                     sizeof(float) * 4 * (size_t)n, tile_rgba, 0, NULL, &ev[3]),
+                                     sizeof(float) * 4 * (size_t)n, tile_rgba, 0, NULL, &ev[4]),
                  fail);
         CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0,
                                      NULL, NULL),
@@ -292,19 +315,32 @@ int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, i
         st->camera_ms += clu_event_ms(ev[0]);
         st->intersect_ms += clu_event_ms(ev[1]);
         st->shading_ms += clu_event_ms(ev[2]);
-        st->readback_ms += clu_event_ms(ev[3]);
-        for (int i = 0; i < 4; i++) clReleaseEvent(ev[i]);
+        if (ev[3]) st->tree_ms += clu_event_ms(ev[3]);
+        st->readback_ms += clu_event_ms(ev[4]);
+        for (int i = 0; i < 5; i++)
+            if (ev[i]) clReleaseEvent(ev[i]);
         memcpy(rgba + 4 * first, tile_rgba, sizeof(float) * 4 * (size_t)n);
         st->rays_primary += (unsigned long long)n;
         st->rays_shadow += counts[VBCL_COUNT_SHADOW];
         st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
         st->traversal_steps += counts[VBCL_COUNT_TRAVERSAL_STEPS];
         st->tri_tests += counts[VBCL_COUNT_TRI_TESTS];
+        st->reflected += counts[VBCL_COUNT_REFLECTED];
+        st->transmitted += counts[VBCL_COUNT_TRANSMITTED];
+        st->pruned += counts[VBCL_COUNT_PRUNED];
+        st->depth_cut += counts[VBCL_COUNT_DEPTH_CUT];
+        st->tir += counts[VBCL_COUNT_TIR];
+        st->pass_through += counts[VBCL_COUNT_PASS_THROUGH];
+        st->interfaces += counts[VBCL_COUNT_INTERFACES];
+        st->energy_errors += counts[VBCL_COUNT_ENERGY_ERRORS];
+        st->by_depth[0] += (unsigned long long)n;
+        for (int k = 1; k < VBCL_COUNT_DEPTH_BINS; k++)
+            st->by_depth[k] += counts[VBCL_COUNT_DEPTH0 + k];
         st->tiles++;
         if (progress) progress_report(t_start, first + n, npix, &shown);
         continue;
     fail:
-        for (int i = 0; i < 4; i++)
+        for (int i = 0; i < 5; i++)
             if (ev[i]) clReleaseEvent(ev[i]);
         if (shown) fputc('\n', stderr);
         snprintf(err, errlen, "%s: %s", d->name, clu_error());
@@ -321,16 +357,16 @@ int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, i
 
 void renderer_release(Renderer *r)
 {
-    cl_mem *mems[] = {&r->tris,      &r->normals,  &r->cell_start, &r->cell_tris,
-                      &r->materials, &r->lights,   &r->frame,      &r->rays,
-                      &r->hits,      &r->radiance, &r->counters};
+    cl_mem *mems[] = {&r->tris,    &r->normals,  &r->cell_start, &r->cell_tris, &r->materials,
+                      &r->objects, &r->lights,   &r->frame,      &r->rays,      &r->hits,
+                      &r->media,   &r->radiance, &r->counters};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) {
             CL_WARN(clReleaseMemObject(*mems[i]));
             *mems[i] = NULL;
         }
-    cl_kernel *ks[] = {&r->k_camera, &r->k_intersect, &r->k_shading};
-    for (size_t i = 0; i < 3; i++)
+    cl_kernel *ks[] = {&r->k_camera, &r->k_intersect, &r->k_shading, &r->k_tree};
+    for (size_t i = 0; i < 4; i++)
         if (*ks[i]) {
             CL_WARN(clReleaseKernel(*ks[i]));
             *ks[i] = NULL;

@@ -11,13 +11,16 @@
 typedef struct RenderStats {
     unsigned long long rays_primary, rays_shadow, shadow_skipped;
     unsigned long long traversal_steps, tri_tests;
+    unsigned long long reflected, transmitted, pruned, depth_cut, tir, pass_through;
+    unsigned long long interfaces, energy_errors;
+    unsigned long long by_depth[VBCL_COUNT_DEPTH_BINS]; /* [0]: primary rays */
     unsigned features;
     char options[512];
     double build_ms;
     int build_cached;
     double grid_ms, upload_ms;
-    double camera_ms, intersect_ms, shading_ms, readback_ms; /* from event profiling */
-    double render_ms;                                        /* wall time of the tile loop */
+    double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
+    double render_ms; /* wall time of the tile loop */
     int tiles, tile_pixels;
 } RenderStats;
 
@@ -25,9 +28,9 @@ typedef struct RenderStats {
 typedef struct Renderer {
     VbDevice *dev;
     cl_program program;
-    cl_kernel k_camera, k_intersect, k_shading;
-    cl_mem tris, normals, cell_start, cell_tris, materials, lights, frame;
-    cl_mem rays, hits, radiance, counters;
+    cl_kernel k_camera, k_intersect, k_shading, k_tree; /* k_tree: with transparency */
+    cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, frame;
+    cl_mem rays, hits, media, radiance, counters;
     Grid grid;
     VbFrame frame_host;
     int tile_pixels;
@@ -45,6 +48,15 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
  * Returns 0, or 1 with a message in err. */
 int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
                     char *err, size_t errlen);
+
+/* Sets the 8 scene arguments every frame kernel (and every shading probe) starts with:
+ * frame, tris, normals, cell_start, cell_tris, materials, objects, lights. */
+int renderer_set_scene_args(const Renderer *r, cl_kernel k);
+
+/* Sets all 14 arguments of a frame kernel: the scene's, then rays, nrays, hits, media,
+ * radiance, counters. */
+int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nrays, cl_mem hits,
+                            cl_mem media, cl_mem radiance, cl_mem counters);
 
 /* Releases everything renderer_init created. */
 void renderer_release(Renderer *r);

@@ -38,6 +38,8 @@ static int fail(Ctx *c, const char *path, const char *fmt, ...)
         snprintf(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
     else
         snprintf(c->err, c->errlen, "%s: %s", c->file, msg);
+    for (char *ch = c->err; *ch; ch++) /* keys and names may hold control characters */
+        if ((unsigned char)*ch < 0x20) *ch = '?';
     return -1;
 }
 
@@ -318,14 +320,17 @@ static int load_camera(Ctx *c, const cJSON *j, Scene *s)
 
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {
-        "max_depth", "grid", "grid_density", "shadow_samples", "ambient", "seed", NULL};
+    static const char *const keys[] = {"max_depth",      "grid",       "grid_density",
+                                       "shadow_samples", "ambient",    "seed",
+                                       "fresnel",        "min_weight", NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = GRID_DEFAULT_DENSITY;
     s->shadow_samples = 16;
     memcpy(s->ambient, amb, sizeof amb);
     s->seed = 1;
+    s->fresnel = SCENE_FRESNEL_EXACT;
+    s->min_weight = 1e-3f;
     if (!j) return 0; /* absent: all defaults */
     if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -334,9 +339,19 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                   &s->grid_density) ||
         get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
         get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
-        get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed))
+        get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
+        get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight))
         return -1;
     s->seed = (unsigned)seed;
+    const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
+    if (fr) {
+        if (cJSON_IsString(fr) && strcmp(fr->valuestring, "exact") == 0)
+            s->fresnel = SCENE_FRESNEL_EXACT;
+        else if (cJSON_IsString(fr) && strcmp(fr->valuestring, "thesis") == 0)
+            s->fresnel = SCENE_FRESNEL_THESIS;
+        else
+            return fail(c, "render.fresnel", "expected \"exact\" or \"thesis\"");
+    }
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(j, "grid");
     if (g) {
         if (cJSON_IsString(g)) {
@@ -502,7 +517,8 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
     char q[PATH_MAX_LEN];
     int rc = 0;
     if (strcmp(shape, "mesh") == 0) {
-        static const char *const keys[] = {"shape", "material", "name", "transform", "file", NULL};
+        static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                           "texture", "file",     NULL};
         if (check_keys(c, o, p, keys)) return -1;
         path_key(q, p, "file");
         const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "file");
@@ -515,7 +531,7 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
         return 0;
     }
     if (strcmp(shape, "sphere") == 0) {
-        static const char *const keys[] = {"shape",  "material", "name",  "transform",
+        static const char *const keys[] = {"shape",  "material", "name",  "transform", "texture",
                                            "radius", "centre",   "level", NULL};
         static const float zero[3] = {0, 0, 0};
         float radius, centre[3];
@@ -532,15 +548,16 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
             mesh_transform(m, &xf);
         }
     } else if (strcmp(shape, "box") == 0) {
-        static const char *const keys[] = {"shape", "material", "name", "transform", "size", NULL};
+        static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                           "texture", "size",     NULL};
         static const float one[3] = {1, 1, 1};
         float size[3];
         if (check_keys(c, o, p, keys) || get_vec(c, o, p, "size", 3, FLT_MIN, FLT_MAX, one, size))
             return -1;
         rc = shape_box(m, v3(size[0], size[1], size[2]));
     } else if (strcmp(shape, "prism") == 0) {
-        static const char *const keys[] = {"shape",  "material", "name", "transform",
-                                           "points", "depth",    NULL};
+        static const char *const keys[] = {"shape",   "material", "name",  "transform",
+                                           "texture", "points",   "depth", NULL};
         float pts[3][2] = {{-0.5f, -0.288675f}, {0.5f, -0.288675f}, {0.0f, 0.577350f}};
         float depth;
         if (check_keys(c, o, p, keys) ||
@@ -563,14 +580,15 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
         if (area == 0) return fail(c, q, "the three points are on one line");
         rc = shape_prism(m, (const float(*)[2])pts, depth);
     } else if (strcmp(shape, "quad") == 0) {
-        static const char *const keys[] = {"shape", "material", "name", "transform", "size", NULL};
+        static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                           "texture", "size",     NULL};
         static const float one[2] = {1, 1};
         float size[2];
         if (check_keys(c, o, p, keys) || get_vec(c, o, p, "size", 2, FLT_MIN, FLT_MAX, one, size))
             return -1;
         rc = shape_quad(m, size[0], size[1]);
     } else if (strcmp(shape, "revolution") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform",
+        static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
                                            "profile", "segments", "caps", NULL};
         int segments;
         if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
@@ -617,6 +635,158 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
     return 0;
 }
 
+/* Maps the texture block [lo, hi] onto the box [host_lo, host_hi] through the unit cube
+ * centred at the origin, where the texture's own transform applies. */
+static mat4 texture_mapping(const float block[6], vec3 host_lo, vec3 host_hi, const mat4 *xf)
+{
+    vec3 bc = v3((block[0] + block[3]) * 0.5f, (block[1] + block[4]) * 0.5f,
+                 (block[2] + block[5]) * 0.5f);
+    vec3 inv = v3(1.0f / (block[3] - block[0]), 1.0f / (block[4] - block[1]),
+                  1.0f / (block[5] - block[2]));
+    mat4 to_unit = mat4_mul(mat4_scale(inv), mat4_translate(v3_scale(bc, -1.0f)));
+    vec3 hc = v3_scale(v3_add(host_lo, host_hi), 0.5f), he = v3_sub(host_hi, host_lo);
+    mat4 to_host = mat4_mul(mat4_translate(hc), mat4_scale(he));
+    return mat4_mul(to_host, mat4_mul(*xf, to_unit));
+}
+
+/* Loads objects[i].texture into tex, in the object's own space (before its transform). */
+static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, vec3 host_lo,
+                        vec3 host_hi, Mesh *tex, int *material)
+{
+    static const char *const keys[] = {"file", "material", "block", "transform", NULL};
+    char q[PATH_MAX_LEN];
+    if (expect_object(c, t, p) || check_keys(c, t, p, keys)) return -1;
+    const cJSON *mat = cJSON_GetObjectItemCaseSensitive(t, "material");
+    path_key(q, p, "material");
+    if (!mat) return fail(c, q, "missing (expected the name of the texture's material)");
+    if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
+    *material = find_material(s, mat->valuestring);
+    if (*material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+    const cJSON *f = cJSON_GetObjectItemCaseSensitive(t, "file");
+    path_key(q, p, "file");
+    if (!f) return fail(c, q, "missing (expected a mesh file of closed texture elements)");
+    if (!cJSON_IsString(f) || !f->valuestring[0])
+        return fail(c, q, "expected a file name, got %s", json_type_name(f));
+    char full[4096], merr[512];
+    join_path(full, sizeof full, s->dir, f->valuestring);
+    if (mesh_load(full, tex, merr, sizeof merr)) return fail(c, q, "%s", merr);
+    if (mesh_check_closed(tex, merr, sizeof merr))
+        return fail(c, q, "%s: texture elements must be closed and consistently oriented: %s",
+                    f->valuestring, merr);
+    float block[6];
+    const cJSON *bj = cJSON_GetObjectItemCaseSensitive(t, "block");
+    path_key(q, p, "block");
+    if (bj) {
+        if (read_vec(c, bj, q, 6, -FLT_MAX, FLT_MAX, block)) return -1;
+        for (int k = 0; k < 3; k++)
+            if (!(block[k + 3] > block[k]))
+                return fail(c, q,
+                            "expected [x0, y0, z0, x1, y1, z1] with x1 > x0, y1 > y0, z1 > z0");
+    } else {
+        vec3 lo, hi;
+        mesh_bounds(tex, &lo, &hi);
+        float b[6] = {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z};
+        for (int k = 0; k < 3; k++)
+            if (!(b[k + 3] > b[k])) b[k + 3] = b[k] + 1.0f; /* flat texture: any thickness */
+        memcpy(block, b, sizeof b);
+    }
+    mat4 xf;
+    if (load_transform(c, t, p, &xf)) return -1;
+    mat4 map = texture_mapping(block, host_lo, host_hi, &xf);
+    if (mat4_det3(&map) == 0.0) return fail(c, p, "the texture mapping is degenerate");
+    mesh_transform(tex, &map);
+    return 0;
+}
+
+/* Appends m to the scene mesh with every triangle tagged tag. */
+static int scene_append(Ctx *c, Scene *s, const Mesh *m, uint32_t tag)
+{
+    uint32_t first = s->mesh.ntris;
+    if (mesh_append(&s->mesh, m)) return fail(c, NULL, "out of memory");
+    uint32_t *tt = realloc(s->tri_tag, sizeof(uint32_t) * (s->mesh.ntris ? s->mesh.ntris : 1));
+    if (!tt) return fail(c, NULL, "out of memory");
+    s->tri_tag = tt;
+    for (uint32_t t = first; t < s->mesh.ntris; t++) tt[t] = tag;
+    return 0;
+}
+
+static int check_finite(Ctx *c, const Mesh *m, const char *p)
+{
+    for (uint32_t v = 0; v < m->nverts; v++)
+        if (!isfinite(m->verts[v].x + m->verts[v].y + m->verts[v].z))
+            return fail(c, p, "vertex %u is not finite after the transform", v);
+    return 0;
+}
+
+static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
+{
+    char q[PATH_MAX_LEN], merr[512];
+    if (expect_object(c, o, p)) return -1;
+    SceneObject *ob = &s->objects[i];
+    ob->tex_slot = -1;
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(o, "name");
+    path_key(q, p, "name");
+    if (name && (!cJSON_IsString(name) || strlen(name->valuestring) >= SCENE_NAME_MAX))
+        return fail(c, q, "expected a string of at most %d characters", SCENE_NAME_MAX - 1);
+    snprintf(ob->name, sizeof ob->name, "%s", name ? name->valuestring : p);
+    const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
+    path_key(q, p, "shape");
+    if (!shape)
+        return fail(c, q, "missing (expected mesh, sphere, box, prism, quad or revolution)");
+    if (!cJSON_IsString(shape))
+        return fail(c, q, "expected a string, got %s", json_type_name(shape));
+    const cJSON *mat = cJSON_GetObjectItemCaseSensitive(o, "material");
+    path_key(q, p, "material");
+    if (!mat) return fail(c, q, "missing (expected the name of a material)");
+    if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
+    ob->material = find_material(s, mat->valuestring);
+    if (ob->material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+
+    Mesh m, tex;
+    mesh_init(&m);
+    mesh_init(&tex);
+    mat4 xf;
+    int rc = -1;
+    if (load_shape(c, o, p, shape->valuestring, s, &m) || load_transform(c, o, p, &xf)) goto done;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "texture");
+    if (t) {
+        path_key(q, p, "texture");
+        if (s->ntextured == VBCL_MAX_TEXTURED) {
+            fail(c, q, "at most %d objects per scene may carry a volume texture",
+                 VBCL_MAX_TEXTURED);
+            goto done;
+        }
+        vec3 lo, hi;
+        mesh_bounds(&m, &lo, &hi);
+        if (load_texture(c, t, q, s, lo, hi, &tex, &ob->tex_material)) goto done;
+        ob->tex_slot = s->ntextured++;
+    }
+    ob->is_host = t != NULL || s->materials[ob->material].gpu.k_global > 0.0f;
+    if (ob->is_host && mesh_check_closed(&m, merr, sizeof merr)) {
+        fail(c, p, "%s object must be a closed, consistently oriented mesh: %s",
+             t ? "a textured" : "a transparent (k_global > 0)", merr);
+        goto done;
+    }
+    mesh_transform(&m, &xf);
+    mesh_transform(&tex, &xf);
+    if (check_finite(c, &m, p) || check_finite(c, &tex, p)) goto done;
+    if ((uint64_t)s->mesh.ntris + m.ntris + tex.ntris > SCENE_MAX_TRIANGLES) {
+        fail(c, p, "the scene has more than %u triangles", SCENE_MAX_TRIANGLES);
+        goto done;
+    }
+    ob->first_tri = s->mesh.ntris;
+    ob->ntris = m.ntris;
+    if (scene_append(c, s, &m, (uint32_t)i)) goto done;
+    ob->first_tex_tri = s->mesh.ntris;
+    ob->ntex_tris = tex.ntris;
+    if (scene_append(c, s, &tex, (uint32_t)i | VBCL_TAG_TEXTURE)) goto done;
+    rc = 0;
+done:
+    mesh_free(&m);
+    mesh_free(&tex);
+    return rc;
+}
+
 static int load_objects(Ctx *c, const cJSON *j, Scene *s)
 {
     if (!j) return fail(c, "objects", "missing (expected an array of objects)");
@@ -624,63 +794,73 @@ static int load_objects(Ctx *c, const cJSON *j, Scene *s)
         return fail(c, "objects", "expected an array, got %s", json_type_name(j));
     int n = cJSON_GetArraySize(j);
     if (n == 0) return fail(c, "objects", "the scene is empty: expected at least one object");
+    if (n > 0x7fffffff / 2) return fail(c, "objects", "too many objects");
     s->objects = calloc((size_t)n, sizeof *s->objects);
     if (!s->objects) return fail(c, NULL, "out of memory");
     int i = 0;
     for (const cJSON *o = j->child; o; o = o->next, i++) {
-        char p[PATH_MAX_LEN], q[PATH_MAX_LEN];
+        char p[PATH_MAX_LEN];
         path_index(p, "objects", i);
-        if (expect_object(c, o, p)) return -1;
-        SceneObject *ob = &s->objects[i];
-        const cJSON *name = cJSON_GetObjectItemCaseSensitive(o, "name");
-        path_key(q, p, "name");
-        if (name && (!cJSON_IsString(name) || strlen(name->valuestring) >= SCENE_NAME_MAX))
-            return fail(c, q, "expected a string of at most %d characters", SCENE_NAME_MAX - 1);
-        snprintf(ob->name, sizeof ob->name, "%s", name ? name->valuestring : p);
-        const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
-        path_key(q, p, "shape");
-        if (!shape)
-            return fail(c, q, "missing (expected mesh, sphere, box, prism, quad or revolution)");
-        if (!cJSON_IsString(shape))
-            return fail(c, q, "expected a string, got %s", json_type_name(shape));
-        const cJSON *mat = cJSON_GetObjectItemCaseSensitive(o, "material");
-        path_key(q, p, "material");
-        if (!mat) return fail(c, q, "missing (expected the name of a material)");
-        if (!cJSON_IsString(mat))
-            return fail(c, q, "expected a string, got %s", json_type_name(mat));
-        ob->material = find_material(s, mat->valuestring);
-        if (ob->material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
-        Mesh m;
-        mesh_init(&m);
-        mat4 xf;
-        if (load_shape(c, o, p, shape->valuestring, s, &m) || load_transform(c, o, p, &xf)) {
-            mesh_free(&m);
-            return -1;
-        }
-        mesh_transform(&m, &xf);
-        for (uint32_t v = 0; v < m.nverts; v++)
-            if (!isfinite(m.verts[v].x + m.verts[v].y + m.verts[v].z)) {
-                mesh_free(&m);
-                return fail(c, p, "vertex %u is not finite after the transform", v);
-            }
-        if ((uint64_t)s->mesh.ntris + m.ntris > SCENE_MAX_TRIANGLES) {
-            mesh_free(&m);
-            return fail(c, p, "the scene has more than %u triangles", SCENE_MAX_TRIANGLES);
-        }
-        ob->first_tri = s->mesh.ntris;
-        ob->ntris = m.ntris;
-        int err = mesh_append(&s->mesh, &m);
-        mesh_free(&m);
-        if (err) return fail(c, NULL, "out of memory");
-        uint32_t *tm =
-            realloc(s->tri_material, sizeof(uint32_t) * (s->mesh.ntris ? s->mesh.ntris : 1));
-        if (!tm) return fail(c, NULL, "out of memory");
-        s->tri_material = tm;
-        for (uint32_t t = ob->first_tri; t < s->mesh.ntris; t++) tm[t] = (uint32_t)ob->material;
+        if (load_object(c, o, p, i, s)) return -1;
+        s->nobjects = i + 1;
     }
-    s->nobjects = n;
     if (s->mesh.ntris == 0) return fail(c, "objects", "no triangles to render");
     return 0;
+}
+
+/* Signed crossings of the ray p + t*d (t > 0) with triangles [first, first+n) of the
+ * scene: +1 leaving through an outward face, -1 entering. Double precision. */
+static int signed_crossings(const Scene *s, uint32_t first, uint32_t n, const double p[3],
+                            const double d[3])
+{
+    int count = 0;
+    for (uint32_t t = first; t < first + n; t++) {
+        double v[3][3];
+        for (int k = 0; k < 3; k++) {
+            vec3 q = s->mesh.verts[s->mesh.tris[3 * t + k]];
+            v[k][0] = q.x, v[k][1] = q.y, v[k][2] = q.z;
+        }
+        double e1[3], e2[3], pv[3], tv[3], qv[3];
+        for (int k = 0; k < 3; k++) e1[k] = v[1][k] - v[0][k], e2[k] = v[2][k] - v[0][k];
+        pv[0] = d[1] * e2[2] - d[2] * e2[1];
+        pv[1] = d[2] * e2[0] - d[0] * e2[2];
+        pv[2] = d[0] * e2[1] - d[1] * e2[0];
+        double det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
+        if (det == 0.0) continue;
+        for (int k = 0; k < 3; k++) tv[k] = p[k] - v[0][k];
+        double u = (tv[0] * pv[0] + tv[1] * pv[1] + tv[2] * pv[2]) / det;
+        if (u < 0.0 || u > 1.0) continue;
+        qv[0] = tv[1] * e1[2] - tv[2] * e1[1];
+        qv[1] = tv[2] * e1[0] - tv[0] * e1[2];
+        qv[2] = tv[0] * e1[1] - tv[1] * e1[0];
+        double w = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) / det;
+        if (w < 0.0 || u + w > 1.0) continue;
+        double tt = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) / det;
+        if (tt <= 0.0) continue;
+        /* the winding's normal e1 x e2 is outward: det < 0 means d points along it */
+        count += det < 0.0 ? 1 : -1;
+    }
+    return count;
+}
+
+void scene_medium_at(const Scene *s, vec3 p, VbMedium *m)
+{
+    /* a direction unlikely to graze edges of axis-aligned or symmetric meshes */
+    const double d[3] = {0.5773502691896258 + 0.0131, 0.5773502691896258 - 0.0217,
+                         0.5773502691896258 + 0.0071};
+    const double q[3] = {p.x, p.y, p.z};
+    m->host = -1;
+    m->tex_counts = 0;
+    for (int i = 0; i < s->nobjects; i++) {
+        const SceneObject *o = &s->objects[i];
+        if (o->is_host && m->host < 0 && signed_crossings(s, o->first_tri, o->ntris, q, d) > 0)
+            m->host = i;
+        if (o->tex_slot >= 0) {
+            int k = signed_crossings(s, o->first_tex_tri, o->ntex_tris, q, d);
+            k = k < 0 ? 0 : k > 255 ? 255 : k;
+            m->tex_counts |= (unsigned)k << (8 * o->tex_slot);
+        }
+    }
 }
 
 int scene_load(const char *path, Scene *s, char *err, size_t errlen)
@@ -761,7 +941,7 @@ void scene_free(Scene *s)
     free(s->lights);
     free(s->materials);
     free(s->objects);
-    free(s->tri_material);
+    free(s->tri_tag);
     mesh_free(&s->mesh);
     memset(s, 0, sizeof *s);
 }

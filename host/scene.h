@@ -22,8 +22,15 @@ typedef struct SceneMaterial {
 typedef struct SceneObject {
     char name[SCENE_NAME_MAX]; /* the JSON path ("objects[2]") when not named */
     int material;
-    uint32_t first_tri, ntris;
+    int is_host;      /* a closed volume tracked by the medium state (dielectric or textured) */
+    int tex_slot;     /* -1: no volume texture */
+    int tex_material; /* the texture's material when tex_slot >= 0 */
+    uint32_t first_tri, ntris;         /* the object's own triangles */
+    uint32_t first_tex_tri, ntex_tris; /* its texture's triangles */
 } SceneObject;
+
+/* How energy splits at an interface (render.fresnel). */
+enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
 
 typedef struct Scene {
     char *path; /* the scene file as given */
@@ -43,6 +50,8 @@ typedef struct Scene {
     int shadow_samples; /* as given; the kernels use the nearest square */
     float ambient[3];
     unsigned seed;
+    int fresnel;      /* SCENE_FRESNEL_* */
+    float min_weight; /* ray-tree pruning threshold */
     /* contents */
     int nlights;
     VbLight *lights;
@@ -50,8 +59,9 @@ typedef struct Scene {
     SceneMaterial *materials;
     int nobjects;
     SceneObject *objects;
-    Mesh mesh;              /* all objects, world space */
-    uint32_t *tri_material; /* material index per triangle of mesh */
+    int ntextured;
+    Mesh mesh;         /* all objects and textures, world space */
+    uint32_t *tri_tag; /* per triangle: object index | VBCL_TAG_TEXTURE for texture triangles */
 } Scene;
 
 /* Reads and checks a scene file. Returns 0, or 2 (bad input) with a one-line message in
@@ -61,6 +71,11 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen);
 
 /* Frees everything scene_load allocated. */
 void scene_free(Scene *s);
+
+/* Where the point p is: the host containing it (hosts must not overlap) and how many
+ * elements of each textured object's texture contain it, by counting signed crossings
+ * of a ray from p in double precision. */
+void scene_medium_at(const Scene *s, vec3 p, VbMedium *m);
 
 /* Parses a grid resolution as written on the command line: "auto", "N" or "NX,NY,NZ".
  * Returns 0 and sets res (all 0 for auto), or -1. */

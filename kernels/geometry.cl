@@ -146,16 +146,24 @@ VB_INLINE float4 tri_vertex(__global const VbTriangle *tris, int tri, int k)
     return (float4)(p[0], p[1], p[2], 0.0f);
 }
 
-inline uint tri_material(__global const VbTriangle *tris, int tri)
+/* The triangle's tag: object index | VBCL_TAG_TEXTURE for volume-texture triangles. */
+VB_INLINE uint tri_tag(__global const VbTriangle *tris, int tri)
 {
     return ((__global const uint *)(tris + tri))[3];
 }
 
 /* Unit geometric normal, from the winding (outward for closed meshes). */
-inline float3 tri_normal(__global const VbTriangle *tris, int tri)
+VB_INLINE float3 tri_normal(__global const VbTriangle *tris, int tri)
 {
     float3 a = tri_vertex(tris, tri, 0).xyz;
     float3 b = tri_vertex(tris, tri, 1).xyz;
     float3 c = tri_vertex(tris, tri, 2).xyz;
     return normalize(cross(b - a, c - a));
+}
+
+/* The point of a hit, interpolated on the triangle (it lies on its plane). */
+VB_INLINE float3 tri_point(__global const VbTriangle *tris, VbHit h)
+{
+    return (1.0f - h.u - h.v) * tri_vertex(tris, h.tri, 0).xyz +
+           h.u * tri_vertex(tris, h.tri, 1).xyz + h.v * tri_vertex(tris, h.tri, 2).xyz;
 }

@@ -44,8 +44,22 @@ typedef struct ShadePoint {
     float3 ns; /* unit shading normal, same side */
     float3 wo; /* unit direction back along the ray */
     uint material;
-    uint key; /* decorrelates this point's random jitter */
+    uint key;        /* decorrelates this point's random jitter */
+    VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
 } ShadePoint;
+
+/* What a shadow feeler from sp lets through toward a light at distance t: 0 or 1, or,
+ * with transparent objects, the transmittance of the interfaces and media it crosses. */
+VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 origin, float3 w,
+                              float t, TraceCount *tc)
+{
+#ifdef VBCL_HAS_TRANSPARENCY
+    return medium_shadow_transmittance(sc, origin, w, t, sp->medium, tc);
+#else
+    (void)sp;
+    return scene_trace_any(sc, origin, w, t, tc) ? (float3)(0.0f) : (float3)(1.0f);
+#endif
+}
 
 /* Counts of one work item's shadow feelers, summed by the caller. */
 typedef struct ShadowCount {
@@ -57,10 +71,9 @@ typedef struct ShadowCount {
  * the point is sampled at strata^2 stratified directions; each direction's feeler is
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
  * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
-VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const VbTriangle *tris,
-                                   __global const uint *cell_start, __global const uint *cell_tris,
-                                   __global const VbLight *light, __global const VbMaterial *m,
-                                   const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
+VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *light,
+                                   __global const VbMaterial *m, const ShadePoint *sp, uint key,
+                                   TraceCount *tc, ShadowCount *sc)
 {
     float3 c = vb_gload3(light->centre);
     float3 radiance = vb_gload3(light->radiance);
@@ -76,7 +89,7 @@ VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const V
     float nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
 #endif
     float3 origin = ray_offset_origin(sp->p, sp->ng);
-    uint strata = f->shadow_strata;
+    uint strata = scn->f->shadow_strata;
 
 #ifdef VBCL_HAS_AREA_LIGHTS
     if (r > 0.0f) {
@@ -94,9 +107,9 @@ VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const V
         float3 tx, ty;
         vb_frame(wc, &tx, &ty);
         float3 sum_d = (float3)(0.0f);
-        float sum_cos = 0.0f;
+        float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
-        float sum_s = 0.0f;
+        float3 sum_s = (float3)(0.0f);
 #endif
         for (uint i = 0; i < strata; i++) {
             for (uint j = 0; j < strata; j++) {
@@ -118,13 +131,13 @@ VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const V
                 float disc = fmax(0.0f, b * b - (d2 - r * r));
                 float t_light = b - sqrt(disc);
                 sc->traced++;
-                if (grid_trace_any(&f->grid, tris, cell_start, cell_tris, origin, w, t_light, tc))
-                    continue;
-                sum_cos += cos_n;
+                float3 vis = light_feeler(scn, sp, origin, w, t_light, tc);
+                if (vb_max3(vis) <= 0.0f) continue;
+                sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
                 float3 hv = normalize(w + sp->wo);
                 float nh = dot(sp->ns, hv);
-                if (nh > nh_min) sum_s += powr(nh, m->exponent) * cos_n;
+                if (nh > nh_min) sum_s += vis * (powr(nh, m->exponent) * cos_n);
 #endif
             }
         }
@@ -144,29 +157,26 @@ VB_INLINE float3 light_reflect_one(__constant const VbFrame *f, __global const V
         return (float3)(0.0f);
     }
     sc->traced++;
-    if (grid_trace_any(&f->grid, tris, cell_start, cell_tris, origin, w, d, tc))
-        return (float3)(0.0f);
+    float3 vis = light_feeler(scn, sp, origin, w, d, tc);
+    if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
     float3 brdf = kd;
 #ifdef VBCL_HAS_SPECULAR
     float3 hv = normalize(w + sp->wo);
     float nh = dot(sp->ns, hv);
     if (nh > nh_min) brdf += ks * (spec_norm * powr(nh, m->exponent));
 #endif
-    return radiance * brdf * (cos_n / d2);
+    return radiance * brdf * vis * (cos_n / d2);
 }
 
 /* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):
  * k_local * (ambient + sum over lights of diffuse + specular). */
-VB_INLINE float3 light_shade_local(__constant const VbFrame *f, __global const VbTriangle *tris,
-                                   __global const uint *cell_start, __global const uint *cell_tris,
-                                   __global const VbMaterial *materials,
-                                   __global const VbLight *lights, const ShadePoint *sp,
-                                   TraceCount *tc, ShadowCount *sc)
+VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, TraceCount *tc,
+                                   ShadowCount *sc)
 {
-    __global const VbMaterial *m = materials + sp->material;
-    float3 col = vb_gload3(m->ambient) * vb_cload3(f->ambient);
-    for (uint l = 0; l < f->nlights; l++)
-        col += light_reflect_one(f, tris, cell_start, cell_tris, lights + l, m, sp,
-                                 vb_hash(sp->key * 0x27d4eb2fu + l), tc, sc);
+    __global const VbMaterial *m = scn->materials + sp->material;
+    float3 col = vb_gload3(m->ambient) * vb_cload3(scn->f->ambient);
+    for (uint l = 0; l < scn->f->nlights; l++)
+        col += light_reflect_one(scn, scn->lights + l, m, sp, vb_hash(sp->key * 0x27d4eb2fu + l),
+                                 tc, sc);
     return m->k_local * col;
 }

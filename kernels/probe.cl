@@ -42,29 +42,48 @@ __kernel void probe_layout(__global uint *out)
     out[9] = VBCL_OFFSETOF(VbLight, radiance);
 }
 
+/* The scene arguments every frame kernel starts with, for probes that shade. */
+#define PROBE_SCENE_ARGS                                                                           \
+    __constant const VbFrame *f, __global const VbTriangle *tris,                                  \
+        __global const VbTriNormals *normals, __global const uint *cell_start,                     \
+        __global const uint *cell_tris, __global const VbMaterial *materials,                      \
+        __global const VbObject *objects, __global const VbLight *lights
+
 /* points (xyz + unused), normals -> radiance: local shading of material 0 at given points
- * with given normals, seen from along the normal. */
-__kernel void probe_shade_points(__constant const VbFrame *f, __global const VbTriangle *tris,
-                                 __global const uint *cell_start, __global const uint *cell_tris,
-                                 __global const VbMaterial *materials,
-                                 __global const VbLight *lights, __global const float *points,
-                                 __global const float *normals, int npoints,
+ * with given normals, seen from along the normal, in the camera's medium. */
+__kernel void probe_shade_points(PROBE_SCENE_ARGS, __global const float *points,
+                                 __global const float *pnormals, int npoints,
                                  __global float *radiance)
 {
     int i = get_global_id(0);
     if (i >= npoints) return;
+    DevScene sc = DEV_SCENE;
     ShadePoint sp;
     sp.p = vload3(0, points + 4 * i);
-    sp.ng = normalize(vload3(0, normals + 4 * i));
+    sp.ng = normalize(vload3(0, pnormals + 4 * i));
     sp.ns = sp.ng;
     sp.wo = sp.ng;
     sp.material = 0;
     sp.key = vb_hash((uint)i);
+    sp.medium = f->camera_medium;
     TraceCount tc = {0, 0};
-    ShadowCount sc = {0, 0};
-    float3 col =
-        light_shade_local(f, tris, cell_start, cell_tris, materials, lights, &sp, &tc, &sc);
-    vstore4((float4)(col, (float)sc.traced), i, radiance);
+    ShadowCount sc2 = {0, 0};
+    float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
+    vstore4((float4)(col, (float)sc2.traced), i, radiance);
+}
+
+/* cases (dir xyz, eta1; normal xyz, eta2) -> (reflected xyz, R; transmitted xyz, T;
+ * tir, 0, 0, 0): the interface optics on their own, normal facing the ray. */
+__kernel void probe_optics(__global const float *in, int n, __global float *out)
+{
+    int i = get_global_id(0);
+    if (i >= n) return;
+    float3 d = vload3(0, in + 8 * i), nrm = vload3(0, in + 8 * i + 4);
+    float eta1 = in[8 * i + 3], eta2 = in[8 * i + 7];
+    OpticsSplit s = optics_split(d, nrm, nrm, eta1, eta2);
+    vstore4((float4)(s.reflected, s.R), 0, out + 12 * i);
+    vstore4((float4)(s.transmitted, s.T), 0, out + 12 * i + 4);
+    vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);
 }
 
 /* shear constants and single-triangle tests for the watertightness checks:

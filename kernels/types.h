@@ -11,7 +11,22 @@
 #define VBCL_FEATURE_AREA_LIGHTS    (1u << 0) /* some light has a radius > 0 */
 #define VBCL_FEATURE_SMOOTH_NORMALS (1u << 1) /* some triangle has vertex normals */
 #define VBCL_FEATURE_SPECULAR       (1u << 2) /* some material has a specular colour */
-#define VBCL_FEATURE_COUNT          3
+#define VBCL_FEATURE_TRANSPARENCY   (1u << 3) /* some object is a dielectric (k_global > 0) */
+#define VBCL_FEATURE_TEXTURES       (1u << 4) /* some object carries a volume texture */
+#define VBCL_FEATURE_ABSORPTION     (1u << 5) /* some dielectric absorbs (extinction > 0) */
+#define VBCL_FEATURE_FRESNEL_THESIS (1u << 6) /* split by thesis eq. 9, not Fresnel */
+#define VBCL_FEATURE_COUNT          7
+
+/* Volume textures: at most this many objects per scene carry one; the medium state keeps
+ * an 8-bit count of elements per textured object. */
+#define VBCL_MAX_TEXTURED 4
+
+/* The tag in a triangle's v0[3]: the object index, with this bit set for triangles of
+ * the object's volume texture. */
+#define VBCL_TAG_TEXTURE 0x80000000u
+
+/* VbObject.flags */
+#define VBCL_OBJECT_HOST 1u /* a closed volume whose inside the medium state tracks */
 
 /* Ray-kind counters kept by the kernels (one atomic add per work item, not per ray). */
 #define VBCL_COUNT_PRIMARY         0
@@ -19,7 +34,17 @@
 #define VBCL_COUNT_SHADOW_SKIPPED  2 /* feelers not traced: light behind the surface */
 #define VBCL_COUNT_TRAVERSAL_STEPS 3
 #define VBCL_COUNT_TRI_TESTS       4
-#define VBCL_COUNTERS              8
+#define VBCL_COUNT_REFLECTED       5 /* secondary rays traced, by kind */
+#define VBCL_COUNT_TRANSMITTED     6
+#define VBCL_COUNT_PRUNED          7  /* branches not traced: weight below min_weight */
+#define VBCL_COUNT_DEPTH_CUT       8  /* branches not traced: deeper than max_depth */
+#define VBCL_COUNT_TIR             9  /* total internal reflections */
+#define VBCL_COUNT_PASS_THROUGH    10 /* crossings that changed no material */
+#define VBCL_COUNT_INTERFACES      11 /* interfaces where the tree split energy */
+#define VBCL_COUNT_ENERGY_ERRORS   12 /* of those, |R + T - 1| > 1e-5 (should stay 0) */
+#define VBCL_COUNT_DEPTH0          16 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH_BINS      16
+#define VBCL_COUNTERS              32
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {
@@ -36,8 +61,8 @@ typedef struct VbHit {
     float u, v; /* barycentric coordinates of the hit on the triangle (w = 1-u-v) */
 } VbHit;
 
-/* A triangle as the kernels read it: three vertices, with w of v[0] holding the
- * material index (as float bits, via as_uint) — one 48-byte record per triangle. */
+/* A triangle as the kernels read it: three vertices, with w of v[0] holding its tag
+ * (object index | VBCL_TAG_TEXTURE, as bits) — one 48-byte record per triangle. */
 typedef struct VbTriangle {
     float v0[4];
     float v1[4];
@@ -63,6 +88,21 @@ typedef struct VbMaterial {
     float k_global;      /* weight of reflected + transmitted light (optics issue) */
     float eta;           /* refractive index (optics issue) */
 } VbMaterial;
+
+/* An object as the kernels see it: its material, and for a host its volume texture. */
+typedef struct VbObject {
+    unsigned int material;     /* the object's own volume and surface */
+    unsigned int tex_material; /* its volume texture's material (when tex_slot >= 0) */
+    int tex_slot;              /* which count of VbMedium.tex_counts, or -1: no texture */
+    unsigned int flags;        /* VBCL_OBJECT_* */
+} VbObject;
+
+/* Where a ray is: inside which host (or none), and inside how many elements of each
+ * textured object's texture (8 bits per slot). The effective material follows. */
+typedef struct VbMedium {
+    int host;                /* object index, or -1: outside every host */
+    unsigned int tex_counts; /* slot s in bits 8s..8s+7 */
+} VbMedium;
 
 /* A spherical light: radiance is uniform over its surface. */
 typedef struct VbLight {
@@ -102,6 +142,11 @@ typedef struct VbFrame {
     unsigned int ntris;
     unsigned int shadow_strata; /* feelers per light per point: shadow_strata^2 */
     unsigned int seed;
+    VbMedium camera_medium;    /* where the camera is, computed on the host */
+    unsigned int air_material; /* index of the material outside every host */
+    float min_weight;          /* branches whose weight is below this in every channel stop */
+    int max_depth;             /* deepest ray-tree level traced (primary rays: 0) */
+    float pad[3];
 } VbFrame;
 
 VBCL_STATIC_ASSERT(sizeof(VbRay) == 32, ray_size);
@@ -118,7 +163,12 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLight, radiance) == 16, light_radiance);
 VBCL_STATIC_ASSERT(sizeof(VbCamera) == 64, camera_size);
 VBCL_STATIC_ASSERT(sizeof(VbGrid) == 80, grid_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGrid, n) == 64, grid_n);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 144 + 32 + 32, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 16, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 240, frame_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, max_depth) == 224, frame_max_depth);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, camera_medium) == 208, frame_camera_medium);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, min_weight) == 220, frame_min_weight);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, grid) == 64, frame_grid);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, background) == 144, frame_background);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, width) == 176, frame_width);

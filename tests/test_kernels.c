@@ -9,98 +9,13 @@
 
 #include "harness.h"
 #include "render.h"
+#include "fixture.h"
 #include "testutil.h"
-
-/* A scene loaded from JSON text and prepared on the test device with the probe kernels. */
-typedef struct Fixture {
-    Scene s;
-    Renderer r;
-    int ok;
-} Fixture;
-
-static int fixture_open(Fixture *fx, const char *json)
-{
-    memset(fx, 0, sizeof *fx);
-    VbDevice *d = tu_device();
-    if (!d) {
-        th_skip("no OpenCL device");
-        return -1;
-    }
-    char err[1024];
-    const char *path = tu_write_file("fixture.json", json);
-    if (scene_load(path, &fx->s, err, sizeof err)) {
-        CHECK(0, "fixture scene: %s", err);
-        return -1;
-    }
-    RenderStats st;
-    memset(&st, 0, sizeof st);
-    if (renderer_init(&fx->r, d, &fx->s, "-DVBCL_TEST_KERNELS", &st, err, sizeof err)) {
-        CHECK(0, "renderer_init: %s", err);
-        scene_free(&fx->s);
-        return -1;
-    }
-    /* the frame buffer normally written per tile */
-    if (clEnqueueWriteBuffer(d->queue, fx->r.frame, CL_TRUE, 0, sizeof(VbFrame), &fx->r.frame_host,
-                             0, NULL, NULL) != CL_SUCCESS) {
-        CHECK(0, "frame upload failed");
-        return -1;
-    }
-    fx->ok = 1;
-    return 0;
-}
-
-static void fixture_close(Fixture *fx)
-{
-    if (fx->ok) renderer_release(&fx->r);
-    if (fx->ok) scene_free(&fx->s);
-    fx->ok = 0;
-}
-
-static cl_mem buffer(const void *data, size_t bytes)
-{
-    VbDevice *d = tu_device();
-    cl_int rc;
-    cl_mem m = clCreateBuffer(d->context, CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0),
-                              bytes, (void *)data, &rc);
-    CHECK(rc == CL_SUCCESS, "clCreateBuffer: %s", clu_error_name(rc));
-    return m;
-}
-
-/* Runs kernel `name` over n work items with the given arguments (all cl_mem or int). */
-static int run_kernel(cl_program prog, const char *name, size_t n, int nargs, const size_t *sizes,
-                      const void *const *vals)
-{
-    VbDevice *d = tu_device();
-    cl_int rc;
-    cl_kernel k = clCreateKernel(prog, name, &rc);
-    CHECK(rc == CL_SUCCESS, "clCreateKernel(%s): %s", name, clu_error_name(rc));
-    if (rc != CL_SUCCESS) return -1;
-    for (int i = 0; i < nargs; i++) {
-        rc = clSetKernelArg(k, (cl_uint)i, sizes[i], vals[i]);
-        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, i, clu_error_name(rc));
-    }
-    size_t global = (n + 63) / 64 * 64;
-    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);
-    CHECK(rc == CL_SUCCESS, "enqueue %s: %s", name, clu_error_name(rc));
-    clFinish(d->queue);
-    clReleaseKernel(k);
-    return rc == CL_SUCCESS ? 0 : -1;
-}
-
-static void read_buffer(cl_mem m, void *dst, size_t bytes)
-{
-    cl_int rc = clEnqueueReadBuffer(tu_device()->queue, m, CL_TRUE, 0, bytes, dst, 0, NULL, NULL);
-    CHECK(rc == CL_SUCCESS, "read: %s", clu_error_name(rc));
-}
 
 /* Closest hits of rays through the grid (scene_intersect_closest). */
 static void trace_grid(Fixture *fx, cl_mem rays, int n, cl_mem hits, cl_mem counters)
 {
-    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                         sizeof(cl_mem), sizeof(int),    sizeof(cl_mem), sizeof(cl_mem)};
-    const void *v[] = {&fx->r.frame, &fx->r.tris, &fx->r.cell_start, &fx->r.cell_tris, &rays,
-                       &n,           &hits,       &counters};
-    run_kernel(fx->r.program, "scene_intersect_closest", (size_t)n, 8, sz, v);
+    fixture_run_frame_kernel(fx, "scene_intersect_closest", rays, n, hits, counters);
 }
 
 static void test_kernel_struct_layout(void)
@@ -285,20 +200,9 @@ static void test_light_irradiance_closed_form(void)
     cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
            mo = buffer(NULL, sizeof out);
     int n = N;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                         sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                         sizeof(int),    sizeof(cl_mem)};
-    const void *v[] = {&fx.r.frame,
-                       &fx.r.tris,
-                       &fx.r.cell_start,
-                       &fx.r.cell_tris,
-                       &fx.r.materials,
-                       &fx.r.lights,
-                       &mp,
-                       &mn,
-                       &n,
-                       &mo};
-    run_kernel(fx.r.program, "probe_shade_points", N, 10, sz, v);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *v[] = {&mp, &mn, &n, &mo};
+    fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
     read_buffer(mo, out, sizeof out);
     for (int i = 0; i < N; i++) {
         double d = cases[i][0], b = cases[i][1] * M_PI / 180.0, s2 = R * R / (d * d);
@@ -318,7 +222,7 @@ static void test_light_irradiance_closed_form(void)
     nrm[0] = 1, nrm[1] = 0, nrm[2] = 0;
     n = 1;
     clEnqueueWriteBuffer(tu_device()->queue, mn, CL_TRUE, 0, sizeof(float) * 4, nrm, 0, NULL, NULL);
-    run_kernel(fx.r.program, "probe_shade_points", 1, 10, sz, v);
+    fixture_run_probe(&fx, "probe_shade_points", 1, 4, sz, v);
     read_buffer(mo, out, sizeof(float) * 4);
     CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced", out[0],
           out[3]);

@@ -100,6 +100,7 @@ int main(int argc, char **argv)
     suite_texgen();
     suite_cli();
     suite_kernels();
+    suite_optics();
     suite_render();
     return th_summary();
 }

@@ -30,6 +30,7 @@ void suite_scene(void);
 void suite_texgen(void);
 void suite_cli(void);
 void suite_kernels(void);
+void suite_optics(void);
 void suite_render(void);
 
 #endif
