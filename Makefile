@@ -35,7 +35,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench-grid
+.PHONY: all run test deps format format-check clean bench-grid stress oclgrind fuzz
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -110,7 +110,49 @@ test: $(BUILD)/vbcl-tests $(BUILD)/vbcl
 bench-grid: vbcl
 	scripts/bench_grid.sh
 
-FORMAT_FILES := $(wildcard host/*.c host/*.h host/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h scripts/*.c)
+# Stress run (docs/testing.md): 10^7 rays at the edges and vertices of closed meshes at
+# three scales, and an 8192x8192 render. Too long for `make test`, which runs a 10^5 version.
+$(BUILD)/vbcl-stress: $(BUILD)/tests/stress/stress_main.o $(BUILD)/tests/watertight.o $(LIB_OBJ)
+	@echo "  LINK    $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+stress: $(BUILD)/vbcl-stress $(BUILD)/vbcl
+	$(Q)$(SAN_ENV) $(BUILD)/vbcl-stress --vbcl $(BUILD)/vbcl
+
+# The kernels under oclgrind on the smallest scene (fails on any error it reports), and the
+# same image on PoCL and on oclgrind, a second OpenCL implementation (docs/testing.md).
+OCLGRIND_FLAGS ?= --check-api --data-races
+oclgrind: $(BUILD)/vbcl
+	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny.json "$(OCLGRIND_FLAGS)"
+	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
+
+# libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
+# run for FUZZ_SECONDS each from the seed corpus in tests/fuzz/corpus/ (docs/testing.md).
+FUZZ_SECONDS ?= 60
+FUZZ_CC      ?= clang
+FUZZ_TARGETS := scene mesh_obj mesh_ply
+FUZZ_SRC     := host/scene.c host/mesh.c host/mesh_io.c host/shapes.c host/grid.c
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk
+	@mkdir -p $(dir $@)
+	@echo "  FUZZ    $@"
+	$(Q)$(FUZZ_CC) $(CSTD) -g -O1 $(WARN) -Wno-unknown-warning-option \
+	    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -Ihost -Ikernels \
+	    $$(pkg-config --cflags libcjson) -o $@ $< $(FUZZ_SRC) $$(pkg-config --libs libcjson) -lm
+
+fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
+	$(Q)for t in $(FUZZ_TARGETS); do \
+	    corpus=$$(echo $$t | sed 's/^mesh_//'); mkdir -p build/fuzz/work-$$t; \
+	    echo "fuzz: $$t for $(FUZZ_SECONDS) s (seeds: tests/fuzz/corpus/$$corpus)"; \
+	    build/fuzz/fuzz_$$t build/fuzz/work-$$t tests/fuzz/corpus/$$corpus \
+	        -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
+	        -print_final_stats=1 -artifact_prefix=build/fuzz/crash-$$t- \
+	        > build/fuzz/$$t.log 2>&1 || { tail -40 build/fuzz/$$t.log; \
+	        echo "fuzz: $$t FAILED: the input is in build/fuzz/crash-$$t-*"; exit 1; }; \
+	    grep -E '^stat::(number_of_executed_units|new_units_added)' build/fuzz/$$t.log; \
+	done
+
+FORMAT_FILES := $(wildcard host/*.c host/*.h host/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \
+                tests/stress/*.c tests/fuzz/*.c tests/fuzz/*.h scripts/*.c)
 format:
 	clang-format -i $(FORMAT_FILES)
 

@@ -52,11 +52,12 @@ static int read_file(const Ctx *c, char **data, size_t *len)
         n += got;
         if (got == 0) break;
     }
-    int bad = ferror(f), eof = feof(f);
+    int bad = ferror(f), eof = feof(f), read_errno = errno;
     fclose(f);
     if (bad || !eof) {
         free(buf);
-        return fail(c, bad ? ": read error" : ": out of memory reading the file");
+        if (bad) return fail(c, ": cannot read: %s", strerror(read_errno));
+        return fail(c, ": out of memory reading the file");
     }
     buf[n] = '\0';
     *data = buf;

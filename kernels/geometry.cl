@@ -39,9 +39,12 @@ inline float vb_max3(float3 v)
 }
 
 /* Moves a point p on a surface off it along the geometric normal n (pointing to the
- * side the new ray leaves into) by a few ulps of p's own magnitude, so a ray from the
- * result cannot hit the surface it starts on, at any scene scale. */
-VB_INLINE float3 ray_offset_origin(float3 p, float3 n)
+ * side the new ray leaves into), so that a ray from the result cannot hit the surface it
+ * starts on, at any scene scale (Waechter & Binder 2019): a few ulps of p's own magnitude,
+ * and at least about 16 ulps of `scale`, the largest vertex coordinate of p's triangle —
+ * the rounding error of a point interpolated on a large triangle grows with its vertices,
+ * not with |p|, so near the origin the first rule alone is too small. */
+VB_INLINE float3 ray_offset_origin(float3 p, float3 n, float scale)
 {
     const float origin = 1.0f / 32.0f;
     const float float_scale = 1.0f / 65536.0f;
@@ -50,8 +53,15 @@ VB_INLINE float3 ray_offset_origin(float3 p, float3 n)
     int3 neg = isless(p, (float3)(0.0f));
     float3 p_i = as_float3(as_int3(p) + select(of_i, -of_i, neg));
     float3 p_f = p + float_scale * n;
-    return select(p_i, p_f, isless(fabs(p), (float3)(origin)));
+    float3 q = select(p_i, p_f, isless(fabs(p), (float3)(origin)));
+    float need = scale * (1.0f / 1048576.0f);
+    return dot(q - p, n) >= need ? q : p + need * n;
 }
+
+/* The largest vertex coordinate of a triangle, in magnitude: the scale of its rounding. */
+#define TRI_SCALE(tris, tri)                                                                       \
+    vb_max3(fmax(fabs(tri_vertex(tris, tri, 0).xyz),                                               \
+                 fmax(fabs(tri_vertex(tris, tri, 1).xyz), fabs(tri_vertex(tris, tri, 2).xyz))))
 
 /* Per-ray constants of the watertight test: the axis permutation that makes the
  * largest direction component z, and the shear that maps the ray onto +z, folded into
@@ -134,15 +144,33 @@ VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, 
         if (T >= 0.0f || T < tmax * det) return 0;
     }
     float rcp = 1.0f / det;
-    *t_out = T * rcp;
+    float t = T * rcp;
+    /* Reject hits closer than the rounding error of the sheared computation (Pharr, Jakob
+     * & Humphreys, pbrt 3rd ed., 3.9.6): a ray leaving a large triangle near the origin
+     * must not find that triangle again. */
+    const float g2 = 2.0f * 5.9604645e-8f / (1.0f - 2.0f * 5.9604645e-8f);
+    const float g3 = 3.0f * 5.9604645e-8f / (1.0f - 3.0f * 5.9604645e-8f);
+    const float g5 = 5.0f * 5.9604645e-8f / (1.0f - 5.0f * 5.9604645e-8f);
+    float max_z = vb_max3(fabs((float3)(A.z, B.z, C.z)));
+    float max_x = vb_max3(fabs((float3)(ax, bx, cx)));
+    float max_y = vb_max3(fabs((float3)(ay, by, cy)));
+    float delta_x = g5 * (max_x + max_z), delta_y = g5 * (max_y + max_z), delta_z = g3 * max_z;
+    float delta_e = 2.0f * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    float max_e = vb_max3(fabs((float3)(U, V, W)));
+    float delta_t = 3.0f * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) * fabs(rcp);
+    if (!(t > delta_t)) return 0;
+    *t_out = t;
     *u_out = V * rcp;
     *v_out = W * rcp;
     return 1;
 }
 
+/* Vertex k (0, 1, 2) of a triangle, read from its own array (indexing past v0 into v1
+ * would be out of bounds for a checker such as oclgrind). */
 VB_INLINE float4 tri_vertex(__global const VbTriangle *tris, int tri, int k)
 {
-    __global const float *p = (__global const float *)(tris + tri) + 4 * k;
+    __global const VbTriangle *t = tris + tri;
+    __global const float *p = k == 0 ? t->v0 : (k == 1 ? t->v1 : t->v2);
     return (float4)(p[0], p[1], p[2], 0.0f);
 }
 

@@ -46,6 +46,7 @@ typedef struct ShadePoint {
     uint material;
     uint key;        /* decorrelates this point's random jitter */
     VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
+    float scale;     /* largest vertex coordinate of the triangle: sizes the ray offsets */
 } ShadePoint;
 
 /* What a shadow feeler from sp lets through toward a light at distance t: 0 or 1, or,
@@ -88,7 +89,7 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     /* (N.H)^n < 1e-4 below this cosine: such samples skip the costly pow */
     float nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
 #endif
-    float3 origin = ray_offset_origin(sp->p, sp->ng);
+    float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
     uint strata = scn->f->shadow_strata;
 
 #ifdef VBCL_HAS_AREA_LIGHTS

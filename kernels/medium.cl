@@ -96,7 +96,7 @@ VB_INLINE int medium_trace(const DevScene *sc, float3 org, float3 dir, float tma
         *state = c.after;
         (*passes)++;
         float3 ng = tri_normal(sc->tris, h.tri);
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng);
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
     }
     return 0;
 }
@@ -130,7 +130,7 @@ VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, float3 org, flo
         if (vb_max3(trans) < 1e-7f) return (float3)(0.0f); /* nothing gets through */
         state = c.after;
         left -= seg;
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng);
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
     }
     return (float3)(0.0f);
 }

@@ -66,6 +66,7 @@ __kernel void probe_shade_points(PROBE_SCENE_ARGS, __global const float *points,
     sp.material = 0;
     sp.key = vb_hash((uint)i);
     sp.medium = f->camera_medium;
+    sp.scale = 0.0f;
     TraceCount tc = {0, 0};
     ShadowCount sc2 = {0, 0};
     float3 col = light_shade_local(&sc, &sp, &tc, &sc2);

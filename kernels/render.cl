@@ -82,6 +82,7 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     sp.material = material;
     sp.key = key;
     sp.medium = medium;
+    sp.scale = TRI_SCALE(sc->tris, h.tri);
     return sp;
 }
 

@@ -77,9 +77,9 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
     cnt->interfaces++;
     cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
     float3 wg = w * ms->k_global;
-    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng), s.reflected, wg * s.R, before, depth,
-              vb_hash(2u * sp->key + 1u), sc->f, cnt, 0);
+    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s.reflected, wg * s.R, before,
+              depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0);
     if (s.T > 0.0f)
-        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng), s.transmitted, wg * s.T, c->after,
-                  depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1);
+        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted, wg * s.T,
+                  c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1);
 }

@@ -3,7 +3,7 @@
 # Idempotent: a second run installs nothing. Uses sudo when not root.
 set -eu
 
-PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo \
+PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo oclgrind clang \
 libcjson-dev libopenimageio-dev openimageio-tools"
 
 missing=""

@@ -17,6 +17,11 @@
     " \"materials\": {\"m\": {}},\n"                                                               \
     " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}]}\n"
 
+/* A scene whose one object is the mesh file f (relative to the scene). */
+#define MESH_SCENE(f)                                                                              \
+    "{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"           \
+    " \"objects\": [{\"shape\": \"mesh\", \"file\": \"" f "\", \"material\": \"m\"}]}"
+
 static int file_exists(const char *path)
 {
     struct stat st;
@@ -161,8 +166,33 @@ static void test_cli_bad_input_classes(void)
         "{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
         " \"objects\": [{\"shape\": \"revolution\", \"segments\": 100000000, \"material\": \"m\","
         " \"profile\": [[0, 0], [1, 1]]}]}",
-        NULL, "segments");                        /* absurd count */
-    expect_bad(GOOD_SCENE, "--grid 0", "--grid"); /* bad option */
+        NULL, "segments");                               /* absurd count */
+    expect_bad(GOOD_SCENE, "--grid 0", "--grid");        /* bad option */
+    expect_bad(GOOD_SCENE, "--width 100000", "--width"); /* absurd image size */
+    /* unreadable mesh: the tests run as root, so a directory stands in for a file */
+    char dirpath[512];
+    snprintf(dirpath, sizeof dirpath, "%s/unreadable.obj", tu_tmpdir());
+    mkdir(dirpath, 0755);
+    expect_bad(MESH_SCENE("unreadable.obj"), NULL, "unreadable.obj");
+    /* corrupt meshes: a binary PLY cut short, a PLY that announces 4 billion vertices */
+    static const char ply_head[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
+                                   "property float x\nproperty float y\nproperty float z\n"
+                                   "element face 1\nproperty list uchar int vertex_indices\n"
+                                   "end_header\n";
+    char plypath[512];
+    snprintf(plypath, sizeof plypath, "%s/truncated.ply", tu_tmpdir());
+    FILE *f = fopen(plypath, "wb");
+    if (f) {
+        static const float verts[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        fwrite(ply_head, 1, sizeof ply_head - 1, f);
+        fwrite(verts, sizeof verts[0], 7, f); /* two floats and the face short */
+        fclose(f);
+    }
+    expect_bad(MESH_SCENE("truncated.ply"), NULL, "truncated.ply");
+    tu_write_file("huge.ply", "ply\nformat ascii 1.0\nelement vertex 4294967295\n"
+                              "property float x\nproperty float y\nproperty float z\n"
+                              "end_header\n0 0 0\n");
+    expect_bad(MESH_SCENE("huge.ply"), NULL, "huge.ply");
     char out[4096];
     const char *scene = tu_write_file("good.json", GOOD_SCENE);
     char args[1024];

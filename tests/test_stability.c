@@ -1,0 +1,162 @@
+/* test_stability.c — numerical stability and robustness: rays at the edges and vertices
+ * of closed meshes at three scales (no leak, no self-hit), stress scenes rendered without
+ * a NaN or infinity, and the inputs the fuzzers once crashed on. */
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "image_io.h"
+#include "scene.h"
+#include "testutil.h"
+#include "watertight.h"
+
+#define STRESS_DIR     "tests/scenes/stress"
+#define REGRESSION_DIR "tests/fuzz/regressions"
+
+/* Every shape at scales 1e-3, 1 and 1e4, at the origin and moved 50 sizes away: about
+ * 10^5 rays in all (the stress program fires 10^7). */
+static void test_stability_no_leaks_no_self_hits(void)
+{
+    VbDevice *d = tu_device();
+    if (!d) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const double scales[] = {1e-3, 1.0, 1e4};
+    WtStats st;
+    memset(&st, 0, sizeof st);
+    for (int i = 0; i < watertight_nshapes; i++)
+        for (int k = 0; k < 3; k++)
+            for (int moved = 0; moved < 2; moved++) {
+                double s = scales[k];
+                double off[3] = {moved * 50 * s, moved * -30 * s, moved * 40 * s};
+                char json[2048], err[1024];
+                watertight_scene_json(watertight_shapes[i].json, s, off, json, sizeof json);
+                const char *path = tu_write_file("watertight.json", json);
+                WtStats one;
+                memset(&one, 0, sizeof one);
+                int rc =
+                    watertight_run(d, path, watertight_shapes[i].convex, 300,
+                                   (unsigned)(i * 6 + k * 2 + moved), 8, &one, err, sizeof err);
+                CHECK(rc == 0, "%s at scale %g: %s", watertight_shapes[i].name, s, err);
+                CHECK(
+                    one.leaks == 0 && one.brute_leaks == 0,
+                    "%s at scale %g%s: %llu of %llu aimed rays leaked (brute force: %llu of %llu)",
+                    watertight_shapes[i].name, s, moved ? ", moved" : "", one.leaks, one.aimed,
+                    one.brute_leaks, one.brute_aimed);
+                CHECK(one.self_hits == 0,
+                      "%s at scale %g%s: %llu of %llu offset rays hit themselves",
+                      watertight_shapes[i].name, s, moved ? ", moved" : "", one.self_hits,
+                      one.offset_rays);
+                st.aimed += one.aimed, st.leaks += one.leaks;
+                st.brute_aimed += one.brute_aimed, st.brute_leaks += one.brute_leaks;
+                if (one.escapes || one.escapes_out)
+                    fprintf(stderr,
+                            "    %s at scale %g%s: offset origins in the wrong medium: %llu "
+                            "leaving inward, %llu outward\n",
+                            watertight_shapes[i].name, s, moved ? ", moved" : "", one.escapes,
+                            one.escapes_out);
+                st.escapes += one.escapes, st.escapes_out += one.escapes_out;
+                st.offset_rays += one.offset_rays, st.self_hits += one.self_hits;
+                st.skipped += one.skipped, st.seconds += one.seconds;
+            }
+    unsigned long long rays = st.aimed + st.brute_aimed + st.offset_rays;
+    fprintf(stderr,
+            "    %llu rays: %llu aimed at edges and vertices, %llu leaked (brute force %llu of "
+            "%llu); %llu offset rays, %llu self-hits; %llu targets skipped; %.2f Mrays/s\n",
+            rays, st.aimed, st.leaks, st.brute_leaks, st.brute_aimed, st.offset_rays, st.self_hits,
+            st.skipped, st.seconds > 0 ? rays / st.seconds * 1e-6 : 0.0);
+    CHECK(st.aimed >= 29000, "enough aimed rays (%llu)", st.aimed);
+}
+
+/* Renders a stress scene through the binary to EXR: exit 0 within the time limit, and every
+ * pixel finite and non-negative. */
+static void render_finite(const char *name, const char *extra)
+{
+    char img[512], cmd[2048], out[4096], err[512];
+    snprintf(img, sizeof img, "%s/%s.exr", tu_tmpdir(), name);
+    snprintf(cmd, sizeof cmd, "timeout 120 %s %s/%s.json -q -o %s %s", tu_vbcl, STRESS_DIR, name,
+             img, extra);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "%s renders (exit %d, 124 is a hang): %s", name, rc, out);
+    if (rc) return;
+    int w = 0, h = 0;
+    float *px = NULL;
+    if (image_read(img, &w, &h, &px, err, sizeof err)) {
+        CHECK(0, "%s: %s", name, err);
+        return;
+    }
+    long bad = 0, lit = 0;
+    for (long i = 0; i < (long)w * h; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = px[4 * i + c];
+            bad += !isfinite(v) || v < 0.0f;
+            lit += v > 0.0f;
+        }
+    fprintf(stderr, "    %s: %dx%d, %ld non-finite or negative values, %ld positive\n", name, w, h,
+            bad, lit);
+    CHECK(bad == 0, "%s: %ld pixel values are NaN, infinite or negative", name, bad);
+    CHECK(lit > 0, "%s: the image is not all black", name);
+    free(px);
+}
+
+static void test_stability_stress_scenes_finite(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const char *const names[] = {"grazing",         "coincident",     "degenerate",
+                                        "lights_touching", "tiny_scale",     "huge_scale",
+                                        "one_pixel",       "tir_chain",      "index_matched",
+                                        "light_in_glass",  "camera_in_glass"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) render_finite(names[i], "");
+}
+
+/* Every input a fuzzer once crashed on loads without crashing: it is accepted or refused
+ * with a one-line message. */
+static void test_stability_fuzz_regressions(void)
+{
+    DIR *dir = opendir(REGRESSION_DIR);
+    if (!dir) {
+        CHECK(0, "cannot open %s", REGRESSION_DIR);
+        return;
+    }
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(dir))) {
+        const char *dot = strrchr(e->d_name, '.');
+        if (e->d_name[0] == '.' || !dot) continue;
+        char path[1024], err[1024] = "";
+        snprintf(path, sizeof path, "%s/%s", REGRESSION_DIR, e->d_name);
+        int rc;
+        if (!strcmp(dot, ".json")) {
+            Scene s;
+            rc = scene_load(path, &s, err, sizeof err);
+            if (rc == 0) scene_free(&s);
+        } else if (!strcmp(dot, ".obj") || !strcmp(dot, ".ply")) {
+            Mesh m;
+            mesh_init(&m);
+            rc = mesh_load(path, &m, err, sizeof err);
+            mesh_free(&m);
+        } else {
+            continue;
+        }
+        n++;
+        CHECK(rc == 0 || (err[0] && !strchr(err, '\n')), "%s: status %d, message \"%s\"", path, rc,
+              err);
+    }
+    closedir(dir);
+    fprintf(stderr, "    %d regression inputs loaded or refused cleanly\n", n);
+    CHECK(n > 0, "regression inputs found in %s", REGRESSION_DIR);
+}
+
+void suite_stability(void)
+{
+    RUN_TEST(test_stability_no_leaks_no_self_hits);
+    RUN_TEST(test_stability_stress_scenes_finite);
+    RUN_TEST(test_stability_fuzz_regressions);
+}

@@ -1,0 +1,60 @@
+/* watertight.h — rays aimed at the shared edges and vertices of closed meshes, traced on
+ * the device, counting leaks and self-intersections (tests/test_stability.c and the
+ * stress program tests/stress/stress_main.c share it). */
+#ifndef VBCL_WATERTIGHT_H
+#define VBCL_WATERTIGHT_H
+
+#include <stddef.h>
+
+#include "clu.h"
+
+/* Counts over one or more runs; watertight_run adds to them. */
+typedef struct WtStats {
+    unsigned long long aimed;       /* rays aimed at an edge or vertex point (grid kernel) */
+    unsigned long long leaks;       /* of those: no hit, a first hit past the aimed point, or
+                                       (from outside) a first hit on a back face */
+    unsigned long long brute_aimed; /* the same rays traced by probe_intersect_brute */
+    unsigned long long brute_leaks;
+    unsigned long long offset_rays; /* rays leaving hit points from the offset origin */
+    unsigned long long self_hits;   /* of those: hits on the own triangle, or on a neighbour
+                                       whose plane the ray does not cross in double precision */
+    unsigned long long escapes;     /* of those leaving into the inside: first hits within
+                                       1e-3 * size on the wrong side of a neighbour whose plane
+                                       the ray does cross (within rounding): the offset origin
+                                       lies in the other medium */
+    unsigned long long escapes_out; /* the same for rays leaving into the outside (shadow
+                                       feelers), where any hit leaving a convex mesh counts */
+    unsigned long long skipped;     /* targets with no clean entering direction */
+    double seconds;                 /* wall time of the device traces, transfers included */
+} WtStats;
+
+/* A closed shape to fire rays at: the JSON of its shape keys (without the material), and
+ * whether it is convex (a ray leaving it outward may hit nothing). */
+typedef struct WtShape {
+    const char *name;
+    const char *json;
+    int convex;
+} WtShape;
+
+/* The shapes every run covers: icosphere levels, surfaces of revolution, prisms, boxes. */
+extern const WtShape watertight_shapes[];
+extern const int watertight_nshapes;
+
+/* Writes a scene holding one object (object: the JSON of its shape keys, without the
+ * material, e.g. "\"shape\": \"sphere\", \"level\": 3") scaled by `scale` and translated
+ * by offset, into out. */
+void watertight_scene_json(const char *object, double scale, const double offset[3], char *out,
+                           size_t n);
+
+/* Loads the scene at scene_path (its mesh must be closed), prepares it on d with the test
+ * kernels and fires `targets` aimed points' worth of rays at it: per target one ray from
+ * far outside and one from just inside, each crossing the surface at the point, and per
+ * hit two rays leaving it from the offset origin (along the normal and in a random
+ * direction, back into the side the ray came from). The self-hit distance is 1e-3 times
+ * the mesh's bounding-box diagonal; convex: the mesh is convex, so an outward ray must hit
+ * nothing. brute_every > 0 also traces the rays of every brute_every-th target by brute
+ * force. Adds to st. Returns 0, or -1 with a message in err. */
+int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets, unsigned seed,
+                   int brute_every, WtStats *st, char *err, size_t errlen);
+
+#endif
