@@ -261,7 +261,74 @@ static void grid_triangle(const Mesh *m, uint32_t t, double tri[3][3])
     }
 }
 
+/* Sets g->ncells, g->cell and x for g->n over g->lo..hi; ref is the scene's reference length. */
+static void grid_ctx_init(Grid *g, double ref, GridCtx *x)
+{
+    double maxabs = 0.0;
+    g->ncells = (uint32_t)g->n[0] * (uint32_t)g->n[1] * (uint32_t)g->n[2];
+    for (int i = 0; i < 3; i++) {
+        maxabs = fmax(maxabs, fmax(fabs((double)g->lo[i]), fabs((double)g->hi[i])));
+        x->lo[i] = g->lo[i];
+        x->cs[i] = ((double)g->hi[i] - (double)g->lo[i]) / g->n[i];
+        g->cell[i] = (float)x->cs[i];
+    }
+    /* Conservative cells: a hair of the scene size and of float resolution at its
+     * coordinates, plus 1e-5 of the cell, so faces on a cell boundary list on both sides. */
+    x->reach = 1e-6 * ref + 2.0 * FLT_EPSILON * maxabs;
+    for (int i = 0; i < 3; i++) x->half[i] = 0.5 * x->cs[i] + 1e-5 * x->cs[i] + x->reach;
+    x->reach += 1e-5 * fmax(x->cs[0], fmax(x->cs[1], x->cs[2]));
+}
+
+/* Pass 1: adds each cell's number of triangles to cnt (ncells entries, zeroed by the caller).
+ * Returns the number of references; sets *nonempty to the cells with at least one. */
+static uint64_t grid_count(const Grid *g, const GridCtx *x, const Mesh *m, uint32_t *cnt,
+                           uint32_t *nonempty)
+{
+    uint64_t total = 0;
+    uint32_t ne = 0;
+    double tri[3][3];
+    for (uint32_t t = 0; t < m->ntris; t++) {
+        grid_triangle(m, t, tri);
+        grid_visit(g, x, tri, t, cnt, NULL, &total);
+    }
+    for (uint32_t c = 0; c < g->ncells; c++) ne += cnt[c] != 0;
+    *nonempty = ne;
+    return total;
+}
+
+/* Decides whether `auto` refines a grid of `cells` cells whose non-empty cells hold `mean`
+ * triangles on average; prev_cells and prev_mean describe the previous round (0 in the
+ * first). Returns the number of cells to aim for next, or 0 to keep this grid. The mean is
+ * modelled as falling with the per-axis scale s as s^-p, and the step aims a little below the
+ * target so that one step usually suffices. p is 1.25 at first (measured between densities 3
+ * and 48 on the quickstart, spheres36 and glass_bombed_sphere: 1.1 to 1.6; 2 would hold for
+ * triangles much smaller than the cells), then as measured between the last two rounds; a
+ * round that lowered the mean by little (p < 0.5: the cells are already smaller than the
+ * triangles, or the crowding is one spot no cell size splits) ends the refinement. */
+static double grid_auto_next(double cells, double mean, double prev_cells, double prev_mean,
+                             double target, double cap)
+{
+    double p = 1.25;
+    if (!(mean > target) || cells >= cap) return 0.0;
+    if (prev_cells > 0.0) {
+        double s = cbrt(cells / prev_cells);
+        p = s > 1.0 ? log(prev_mean / mean) / log(s) : 0.0;
+        if (!(p >= 0.5)) return 0.0;
+        p = fmin(p, 3.0);
+    }
+    double s = pow(mean / (0.9 * target), 1.0 / p);
+    s = fmin(fmax(s, 1.1), 2.0); /* 1.33 to 8 times the cells */
+    double want = fmin(cells * s * s * s, cap);
+    return want >= 1.2 * cells ? want : 0.0;
+}
+
 int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *err, size_t errlen)
+{
+    return grid_build_tuned(g, m, res, density, GRID_AUTO_TARGET, GRID_AUTO_MAX_CELLS, err, errlen);
+}
+
+int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, float target,
+                     uint32_t max_cells, char *err, size_t errlen)
 {
     double t0 = now_ms();
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -304,6 +371,7 @@ int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *er
 
     int use_auto = res == NULL || res[0] <= 0 || res[1] <= 0 || res[2] <= 0;
     if (use_auto) {
+        if (!(density > 0.0f) || !isfinite(density)) density = GRID_DEFAULT_DENSITY;
         grid_auto_resolution(g->lo, g->hi, ntris, density, g->n);
     } else {
         uint64_t cells = 1;
@@ -316,35 +384,44 @@ int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *er
         }
         for (int i = 0; i < 3; i++) g->n[i] = res[i];
     }
-    g->ncells = (uint32_t)g->n[0] * (uint32_t)g->n[1] * (uint32_t)g->n[2];
 
+    /* Pass 1, once per resolution tried: count each cell's triangles into cell_start[cell].
+     * `auto` keeps raising the resolution while the non-empty cells are crowded. */
     GridCtx x;
-    double maxabs = 0.0;
-    for (int i = 0; i < 3; i++) {
-        maxabs = fmax(maxabs, fmax(fabs((double)g->lo[i]), fabs((double)g->hi[i])));
-        x.lo[i] = g->lo[i];
-        x.cs[i] = ((double)g->hi[i] - (double)g->lo[i]) / g->n[i];
-        g->cell[i] = (float)x.cs[i];
-    }
-    /* Conservative cells: a hair of the scene size and of float resolution at its
-     * coordinates, plus 1e-5 of the cell, so faces on a cell boundary list on both sides. */
-    x.reach = 1e-6 * ref + 2.0 * FLT_EPSILON * maxabs;
-    for (int i = 0; i < 3; i++) x.half[i] = 0.5 * x.cs[i] + 1e-5 * x.cs[i] + x.reach;
-    x.reach += 1e-5 * fmax(x.cs[0], fmax(x.cs[1], x.cs[2]));
-
-    g->cell_start = calloc((size_t)g->ncells + 1, sizeof *g->cell_start);
-    if (!g->cell_start) {
-        grid_error(err, errlen, "grid: out of memory for %u cells", g->ncells);
-        grid_free(g);
-        return -1;
-    }
-
-    /* Pass 1: count each cell's triangles into cell_start[cell]. */
-    uint64_t total = 0;
-    double tri[3][3];
-    for (uint32_t t = 0; t < ntris; t++) {
-        grid_triangle(m, t, tri);
-        grid_visit(g, &x, tri, t, g->cell_start, NULL, &total);
+    uint64_t total;
+    uint32_t nonempty;
+    double prev_cells = 0.0, prev_mean = 0.0;
+    double cap = fmin((double)max_cells, (double)GRID_MAX_CELLS);
+    for (;;) {
+        grid_ctx_init(g, ref, &x);
+        g->cell_start = calloc((size_t)g->ncells + 1, sizeof *g->cell_start);
+        if (!g->cell_start) {
+            grid_error(err, errlen, "grid: out of memory for %u cells", g->ncells);
+            grid_free(g);
+            return -1;
+        }
+        total = grid_count(g, &x, m, g->cell_start, &nonempty);
+        if (!use_auto || !(target > 0.0f) || g->refinements >= GRID_AUTO_MAX_ROUNDS ||
+            nonempty == 0)
+            break;
+        double mean = (double)total / nonempty;
+        double want = grid_auto_next(g->ncells, mean, prev_cells, prev_mean, target, cap);
+        if (want == 0.0) break;
+        int n[3];
+        grid_auto_resolution(g->lo, g->hi, ntris, (float)(want / fmax(ntris, 1.0)), n);
+        while ((double)n[0] * n[1] * n[2] > cap) { /* rounding may overshoot the cap */
+            int big = 0;
+            for (int i = 1; i < 3; i++)
+                if (n[i] > n[big]) big = i;
+            n[big]--;
+        }
+        if ((double)n[0] * n[1] * n[2] <= g->ncells) break;
+        prev_cells = g->ncells;
+        prev_mean = mean;
+        memcpy(g->n, n, sizeof n);
+        free(g->cell_start);
+        g->cell_start = NULL;
+        g->refinements++;
     }
     if (total > UINT32_MAX) {
         grid_error(err, errlen,
@@ -365,16 +442,16 @@ int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *er
 
     /* Counts become start offsets; pass 2 advances each to its cell's end; shifting by one
      * cell then gives the starts again, with cell_start[ncells] = nrefs. */
-    uint32_t sum = 0, maxc = 0, empty = 0;
+    uint32_t sum = 0, maxc = 0;
     for (uint32_t c = 0; c < g->ncells; c++) {
         uint32_t k = g->cell_start[c];
         maxc = k > maxc ? k : maxc;
-        empty += k == 0;
         g->cell_start[c] = sum;
         sum += k;
     }
     g->cell_start[g->ncells] = sum;
     total = 0;
+    double tri[3][3];
     for (uint32_t t = 0; t < ntris; t++) {
         grid_triangle(m, t, tri);
         grid_visit(g, &x, tri, t, g->cell_start, g->cell_tris, &total);
@@ -384,7 +461,9 @@ int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *er
 
     g->tris_per_cell_mean = (float)((double)g->nrefs / g->ncells);
     g->tris_per_cell_max = maxc;
-    g->empty_fraction = (float)((double)empty / g->ncells);
+    g->nonempty = nonempty;
+    g->tris_per_nonempty_mean = nonempty ? (float)((double)g->nrefs / nonempty) : 0.0f;
+    g->empty_fraction = (float)((double)(g->ncells - nonempty) / g->ncells);
     g->build_ms = now_ms() - t0;
     return 0;
 }

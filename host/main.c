@@ -206,10 +206,10 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
     fprintf(
         stderr,
         "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max %u, "
-        "empty %.1f%%\n",
+        "empty %.1f%%, per non-empty cell %.2f, refined %d times\n",
         r->grid.n[0], r->grid.n[1], r->grid.n[2], r->grid.ncells, s->grid_res[0] ? "given" : "auto",
         st->grid_ms, r->grid.tris_per_cell_mean, r->grid.tris_per_cell_max,
-        100.0 * r->grid.empty_fraction);
+        100.0 * r->grid.empty_fraction, r->grid.tris_per_nonempty_mean, r->grid.refinements);
     fprintf(stderr,
             "rays        primary %llu, shadow %llu (%u per light per point; %llu skipped: light "
             "behind the surface), total %llu\n",

@@ -417,9 +417,11 @@ static void test_build_meshes(void)
             if (ri != 1)
                 for (int a = 0; a < 3; a++)
                     CHECK(g.n[a] == res[ri][a], "%s: n[%d] = %d", label, a, g.n[a]);
-            else
-                CHECK(g.ncells >= meshes[mi].ntris && g.ncells <= 6 * meshes[mi].ntris,
-                      "%s: auto gave %u cells for %u triangles", label, g.ncells, meshes[mi].ntris);
+            else /* the estimate, refined while the non-empty cells are crowded */
+                CHECK(g.ncells >= meshes[mi].ntris && g.ncells <= 64 * meshes[mi].ntris &&
+                          (g.tris_per_nonempty_mean <= GRID_AUTO_TARGET || g.refinements == 0),
+                      "%s: auto gave %u cells for %u triangles after %d refinements", label,
+                      g.ncells, meshes[mi].ntris, g.refinements);
             if (ri == 0)
                 CHECK(g.nrefs == meshes[mi].ntris, "%s: %u references for %u triangles", label,
                       g.nrefs, meshes[mi].ntris);
@@ -567,6 +569,164 @@ static void test_auto_resolution(void)
     }
 }
 
+/* A "stadium": a two-triangle floor quad of half-width `half` at y = 0 and a dense sphere of
+ * radius 1 standing on it at the origin, so the floor stretches the bounds beyond the
+ * detail. (A far larger floor fills so many cells with its one or two triangles that the
+ * mean per non-empty cell falls below the target however crowded the sphere's cells are:
+ * a known limit of that statistic, see docs/architecture.md.) */
+static Mesh mesh_stadium(float half, int nlat, int nlon)
+{
+    const float centre[3] = {0.0f, 1.0f, 0.0f};
+    Mesh s = mesh_sphere(nlat, nlon, 1.0f, centre);
+    Mesh m = mesh_make(s.nverts + 4, s.ntris + 2);
+    memcpy(m.verts, s.verts, s.nverts * sizeof *m.verts);
+    memcpy(m.tris, s.tris, 3 * (size_t)s.ntris * sizeof *m.tris);
+    uint32_t v = s.nverts, *t = &m.tris[3 * (size_t)s.ntris];
+    m.verts[v] = v3(-half, 0, -half), m.verts[v + 1] = v3(half, 0, -half);
+    m.verts[v + 2] = v3(half, 0, half), m.verts[v + 3] = v3(-half, 0, half);
+    t[0] = v, t[1] = v + 2, t[2] = v + 1, t[3] = v, t[4] = v + 3, t[5] = v + 2;
+    mesh_release(&s);
+    return m;
+}
+
+/* The product of a built grid's resolution, and its cells as auto's density-only estimate
+ * would give them. */
+static uint64_t estimate_cells(const Grid *g, uint32_t ntris, float density)
+{
+    int n[3];
+    grid_auto_resolution(g->lo, g->hi, ntris, density, n);
+    return (uint64_t)n[0] * (uint64_t)n[1] * (uint64_t)n[2];
+}
+
+/* Auto on a stadium refines the density estimate until the non-empty cells hold at most
+ * GRID_AUTO_TARGET triangles on average, keeps the cells' shape, lists everything, and is
+ * the estimate itself with refinement off (target 0). */
+static void test_auto_stadium(void)
+{
+    Mesh m = mesh_stadium(4.0f, 64, 128);
+    Grid g0, g;
+    char err[256] = "";
+    CHECK(grid_build_tuned(&g0, &m, NULL, 0.0f, 0.0f, GRID_AUTO_MAX_CELLS, err, sizeof err) == 0,
+          "density-only build failed: %s", err);
+    CHECK(g0.refinements == 0 && g0.ncells == estimate_cells(&g0, m.ntris, GRID_DEFAULT_DENSITY),
+          "target 0: %d refinements, %u cells", g0.refinements, g0.ncells);
+    CHECK(g0.tris_per_nonempty_mean > 1.5f * GRID_AUTO_TARGET,
+          "the stadium is not crowded: %.2f per non-empty cell at %dx%dx%d",
+          g0.tris_per_nonempty_mean, g0.n[0], g0.n[1], g0.n[2]);
+    CHECK(grid_build(&g, &m, NULL, 0.0f, err, sizeof err) == 0, "auto build failed: %s", err);
+    CHECK(g.refinements >= 1 && g.refinements <= GRID_AUTO_MAX_ROUNDS, "%d refinements",
+          g.refinements);
+    CHECK(g.tris_per_nonempty_mean <= GRID_AUTO_TARGET,
+          "refined to %dx%dx%d = %u cells: %.2f triangles per non-empty cell", g.n[0], g.n[1],
+          g.n[2], g.ncells, g.tris_per_nonempty_mean);
+    CHECK(g.ncells > 4 * g0.ncells && g.ncells <= GRID_AUTO_MAX_CELLS, "%u cells, estimate %u",
+          g.ncells, g0.ncells);
+    CHECK(g.tris_per_cell_max < g0.tris_per_cell_max, "max per cell %u, estimate %u",
+          g.tris_per_cell_max, g0.tris_per_cell_max);
+    for (int a = 0; a < 3; a++) /* same shape: every axis grows by about the same factor */
+        CHECK(fabs((double)g.n[a] / g0.n[a] - cbrt((double)g.ncells / g0.ncells)) <
+                  0.25 * cbrt((double)g.ncells / g0.ncells),
+              "axis %d: %d -> %d cells, total %u -> %u", a, g0.n[a], g.n[a], g0.ncells, g.ncells);
+    uint32_t ne = 0;
+    for (uint32_t c = 0; c < g.ncells; c++) ne += g.cell_start[c + 1] > g.cell_start[c];
+    CHECK(ne == g.nonempty && fabsf(g.tris_per_nonempty_mean - (float)g.nrefs / (float)ne) <=
+                                  1e-5f * g.tris_per_nonempty_mean,
+          "non-empty %u (recount %u), mean %g", g.nonempty, ne, g.tris_per_nonempty_mean);
+    /* A higher starting density starts nearer and refines no more. */
+    Grid g8;
+    CHECK(grid_build(&g8, &m, NULL, 24.0f, err, sizeof err) == 0, "density 24 failed: %s", err);
+    CHECK(g8.refinements <= g.refinements && g8.tris_per_nonempty_mean <= GRID_AUTO_TARGET,
+          "density 24: %d refinements, %.2f per non-empty cell", g8.refinements,
+          g8.tris_per_nonempty_mean);
+    grid_free(&g8);
+    grid_free(&g0);
+    /* The refined grid is complete and exact (a smaller stadium keeps the check short). */
+    grid_free(&g);
+    mesh_release(&m);
+    m = mesh_stadium(3.0f, 16, 32);
+    CHECK(grid_build(&g, &m, NULL, 0.0f, err, sizeof err) == 0, "small stadium failed: %s", err);
+    CHECK(g.refinements >= 1, "small stadium not refined (%dx%dx%d, %.2f per non-empty cell)",
+          g.n[0], g.n[1], g.n[2], g.tris_per_nonempty_mean);
+    check_grid(&g, &m, "refined stadium");
+    grid_free(&g);
+    mesh_release(&m);
+}
+
+/* The cap on refinement is respected: a stadium that wants far more cells stops at the cap
+ * (still above the target), and a cap below the estimate keeps the estimate. */
+static void test_auto_cap(void)
+{
+    Mesh m = mesh_stadium(4.0f, 64, 128);
+    Grid g0, g;
+    char err[256] = "";
+    const uint32_t caps[3] = {70000, 150000, 20};
+    CHECK(grid_build_tuned(&g0, &m, NULL, 0.0f, 0.0f, GRID_AUTO_MAX_CELLS, err, sizeof err) == 0,
+          "density-only build failed: %s", err);
+    for (int i = 0; i < 3; i++) {
+        CHECK(grid_build_tuned(&g, &m, NULL, 0.0f, GRID_AUTO_TARGET, caps[i], err, sizeof err) == 0,
+              "cap %u: build failed: %s", caps[i], err);
+        if (caps[i] < g0.ncells) {
+            CHECK(g.refinements == 0 && g.ncells == g0.ncells,
+                  "cap %u below the estimate: %d refinements, %u cells", caps[i], g.refinements,
+                  g.ncells);
+        } else {
+            CHECK(g.ncells <= caps[i] && g.ncells > caps[i] / 2 && g.refinements >= 1,
+                  "cap %u: %dx%dx%d = %u cells after %d refinements", caps[i], g.n[0], g.n[1],
+                  g.n[2], g.ncells, g.refinements);
+            CHECK(g.tris_per_nonempty_mean > GRID_AUTO_TARGET,
+                  "cap %u: target %.2f reached, the cap did not bind", caps[i],
+                  g.tris_per_nonempty_mean);
+        }
+        grid_free(&g);
+    }
+    grid_free(&g0);
+    mesh_release(&m);
+}
+
+/* A uniform random soup, whose cells are evenly filled, is left at (or near) the estimate. */
+static void test_auto_uniform(void)
+{
+    const double centre[3] = {0.5, -1.0, 2.0};
+    const uint32_t counts[2] = {2000, 20000};
+    for (int i = 0; i < 2; i++) {
+        Mesh m = mesh_random(counts[i], centre, 11 + (uint64_t)i);
+        Grid g;
+        char err[256] = "";
+        CHECK(grid_build(&g, &m, NULL, 0.0f, err, sizeof err) == 0, "%u: build failed: %s",
+              counts[i], err);
+        uint64_t est = estimate_cells(&g, m.ntris, GRID_DEFAULT_DENSITY);
+        CHECK(g.refinements <= 1 && g.ncells <= 4 * est,
+              "soup of %u: %d refinements to %dx%dx%d = %u cells (estimate %llu), %.2f per "
+              "non-empty cell",
+              counts[i], g.refinements, g.n[0], g.n[1], g.n[2], g.ncells, (unsigned long long)est,
+              g.tris_per_nonempty_mean);
+        grid_free(&g);
+        mesh_release(&m);
+    }
+}
+
+/* An explicit resolution is used as given, however crowded its cells. */
+static void test_auto_explicit(void)
+{
+    Mesh m = mesh_stadium(40.0f, 16, 32);
+    const int res[3][3] = {{1, 1, 1}, {8, 2, 8}, {30, 5, 17}};
+    for (int i = 0; i < 3; i++) {
+        Grid g;
+        char err[256] = "";
+        CHECK(grid_build(&g, &m, res[i], 0.0f, err, sizeof err) == 0, "build failed: %s", err);
+        CHECK(g.n[0] == res[i][0] && g.n[1] == res[i][1] && g.n[2] == res[i][2] &&
+                  g.refinements == 0,
+              "asked %dx%dx%d, got %dx%dx%d after %d refinements", res[i][0], res[i][1], res[i][2],
+              g.n[0], g.n[1], g.n[2], g.refinements);
+        if (i < 2)
+            CHECK(g.tris_per_nonempty_mean > GRID_AUTO_TARGET,
+                  "%dx%dx%d: only %.2f per non-empty cell", g.n[0], g.n[1], g.n[2],
+                  g.tris_per_nonempty_mean);
+        grid_free(&g);
+    }
+    mesh_release(&m);
+}
+
 /* A flat scene (one quad) gets a non-zero thickness and, with auto, one cell across it. */
 static void test_flat_scene(void)
 {
@@ -671,6 +831,10 @@ void suite_grid_build(void)
     RUN_TEST(test_build_meshes);
     RUN_TEST(test_boundary_planes);
     RUN_TEST(test_auto_resolution);
+    RUN_TEST(test_auto_stadium);
+    RUN_TEST(test_auto_cap);
+    RUN_TEST(test_auto_uniform);
+    RUN_TEST(test_auto_explicit);
     RUN_TEST(test_flat_scene);
     RUN_TEST(test_degenerate);
     RUN_TEST(test_build_errors);
