@@ -4,6 +4,8 @@
 
 #include "clu.h"
 
+#include "cache.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <stdint.h>
@@ -260,42 +262,6 @@ void clu_device_close(VbDevice *d)
     d->context = NULL;
 }
 
-static uint64_t fnv1a(uint64_t h, const char *s)
-{
-    for (; *s; s++) {
-        h ^= (unsigned char)*s;
-        h *= 1099511628211ull;
-    }
-    return h ^ 0xff;
-}
-
-/* The cache directory, created if needed, or NULL when caching is off or impossible. */
-static const char *cache_dir(char *buf, size_t n)
-{
-    const char *env = getenv("VBCL_CACHE_DIR");
-    if (env && strcmp(env, "off") == 0) return NULL;
-    if (env && *env) {
-        snprintf(buf, n, "%s", env);
-    } else {
-        const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
-        if (xdg && *xdg)
-            snprintf(buf, n, "%s/vbcl", xdg);
-        else if (home && *home)
-            snprintf(buf, n, "%s/.cache/vbcl", home);
-        else
-            return NULL;
-    }
-    /* create each component */
-    for (char *p = buf + 1; *p; p++) {
-        if (*p != '/') continue;
-        *p = 0;
-        mkdir(buf, 0755);
-        *p = '/';
-    }
-    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return NULL;
-    return buf;
-}
-
 static unsigned char *read_all(const char *path, size_t *len)
 {
     FILE *f = fopen(path, "rb");
@@ -360,13 +326,13 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
     cl_program prog = NULL;
     *cached = 0;
     char dir[4096], path[4200] = "";
-    if (cache_dir(dir, sizeof dir)) {
-        uint64_t h = 1469598103934665603ull;
-        h = fnv1a(h, source);
-        h = fnv1a(h, options);
-        h = fnv1a(h, d->name);
-        h = fnv1a(h, d->version);
-        h = fnv1a(h, d->driver);
+    if (cache_dir(NULL, dir, sizeof dir)) {
+        uint64_t h = CACHE_HASH_SEED;
+        h = cache_hash(h, source);
+        h = cache_hash(h, options);
+        h = cache_hash(h, d->name);
+        h = cache_hash(h, d->version);
+        h = cache_hash(h, d->driver);
         snprintf(path, sizeof path, "%s/%016llx.bin", dir, (unsigned long long)h);
         size_t len = 0;
         unsigned char *bin = read_all(path, &len);

@@ -251,6 +251,7 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
+    scene_texgen = texgen_run_quiet;
     double t0 = clu_now_ms();
     Options o;
     int rc = parse_args(argc, argv, &o);

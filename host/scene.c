@@ -10,9 +10,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <cJSON.h>
 
+#include "cache.h"
 #include "grid.h"
 
 #define PATH_MAX_LEN 256
@@ -649,11 +651,77 @@ static mat4 texture_mapping(const float block[6], vec3 host_lo, vec3 host_hi, co
     return mat4_mul(to_host, mat4_mul(*xf, to_unit));
 }
 
+SceneTexgenFn scene_texgen;
+
+/* Reads the texture block a vbcl texgen file declares in its header ("# block x0 y0 z0 x1
+ * y1 z1" in OBJ, "comment block ..." in PLY). Returns 1 when found and valid. */
+static int read_block_comment(const char *path, float block[6])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    char line[512];
+    int found = 0;
+    for (int n = 0; n < 64 && !found && fgets(line, sizeof line, f); n++) {
+        const char *l = line;
+        if (*l == '#')
+            l++;
+        else if (strncmp(l, "comment", 7) == 0)
+            l += 7;
+        else if (strncmp(l, "ply", 3) != 0 && strncmp(l, "format", 6) != 0)
+            break; /* past the header */
+        while (*l == ' ') l++;
+        if (strncmp(l, "block ", 6) != 0) continue;
+        found = sscanf(l + 6, "%f %f %f %f %f %f", &block[0], &block[1], &block[2], &block[3],
+                       &block[4], &block[5]) == 6;
+        for (int k = 0; k < 3 && found; k++)
+            found = isfinite(block[k]) && isfinite(block[k + 3]) && block[k + 3] > block[k];
+    }
+    fclose(f);
+    return found;
+}
+
+/* Runs `vbcl texgen ARGS` for objects[i].texture.generate into the cache (or a temporary
+ * file when the cache is off), unless the cache already holds it; writes its path. */
+static int generate_texture(Ctx *c, const char *q, const char *args, char *path, size_t n,
+                            int *temporary)
+{
+    char dir[4096], err[768];
+    uint64_t h = cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: ");
+    h = cache_hash(h, args);
+    *temporary = 0;
+    if (cache_dir("textures", dir, sizeof dir)) {
+        snprintf(path, n, "%s/%016llx.ply", dir, (unsigned long long)h);
+    } else {
+        snprintf(path, n, "/tmp/vbcl-texture-%ld-%016llx.ply", (long)getpid(),
+                 (unsigned long long)h);
+        *temporary = 1;
+    }
+    if (!*temporary && access(path, R_OK) == 0) return 0; /* generated before */
+    char buf[1024], *argv[66];
+    int argc = 0;
+    if (strlen(args) >= sizeof buf - 1) return fail(c, q, "too long");
+    snprintf(buf, sizeof buf, "%s", args);
+    argv[argc++] = (char *)"texgen";
+    for (char *tok = strtok(buf, " \t\n"); tok; tok = strtok(NULL, " \t\n")) {
+        if (argc == 62) return fail(c, q, "too many arguments");
+        if (!strcmp(tok, "-o") || !strcmp(tok, "--output"))
+            return fail(c, q, "give the texgen arguments without -o: the scene chooses the file");
+        argv[argc++] = tok;
+    }
+    argv[argc++] = (char *)"-o";
+    argv[argc++] = path;
+    argv[argc] = NULL;
+    if (!scene_texgen) return fail(c, q, "this program cannot generate textures");
+    int rc = scene_texgen(argc, argv, err, sizeof err);
+    if (rc) return fail(c, q, "vbcl texgen %s", err);
+    return 0;
+}
+
 /* Loads objects[i].texture into tex, in the object's own space (before its transform). */
 static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, vec3 host_lo,
                         vec3 host_hi, Mesh *tex, int *material)
 {
-    static const char *const keys[] = {"file", "material", "block", "transform", NULL};
+    static const char *const keys[] = {"file", "generate", "material", "block", "transform", NULL};
     char q[PATH_MAX_LEN];
     if (expect_object(c, t, p) || check_keys(c, t, p, keys)) return -1;
     const cJSON *mat = cJSON_GetObjectItemCaseSensitive(t, "material");
@@ -663,16 +731,35 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
     *material = find_material(s, mat->valuestring);
     if (*material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
     const cJSON *f = cJSON_GetObjectItemCaseSensitive(t, "file");
-    path_key(q, p, "file");
-    if (!f) return fail(c, q, "missing (expected a mesh file of closed texture elements)");
-    if (!cJSON_IsString(f) || !f->valuestring[0])
-        return fail(c, q, "expected a file name, got %s", json_type_name(f));
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(t, "generate");
     char full[4096], merr[512];
-    join_path(full, sizeof full, s->dir, f->valuestring);
-    if (mesh_load(full, tex, merr, sizeof merr)) return fail(c, q, "%s", merr);
+    const char *shown;
+    int temporary = 0;
+    if (f && g) return fail(c, p, "give \"file\" or \"generate\", not both");
+    if (g) {
+        path_key(q, p, "generate");
+        if (!cJSON_IsString(g) || !g->valuestring[0])
+            return fail(c, q, "expected the arguments of vbcl texgen, such as \"bomb --count 30\"");
+        if (generate_texture(c, q, g->valuestring, full, sizeof full, &temporary)) return -1;
+        shown = "the generated texture";
+    } else {
+        path_key(q, p, "file");
+        if (!f)
+            return fail(
+                c, q, "missing (expected a mesh file of closed texture elements, or \"generate\")");
+        if (!cJSON_IsString(f) || !f->valuestring[0])
+            return fail(c, q, "expected a file name, got %s", json_type_name(f));
+        join_path(full, sizeof full, s->dir, f->valuestring);
+        shown = f->valuestring;
+    }
+    int bad = mesh_load(full, tex, merr, sizeof merr);
+    float declared[6];
+    int has_declared = !bad && read_block_comment(full, declared);
+    if (temporary) remove(full);
+    if (bad) return fail(c, q, "%s", merr);
     if (mesh_check_closed(tex, merr, sizeof merr))
         return fail(c, q, "%s: texture elements must be closed and consistently oriented: %s",
-                    f->valuestring, merr);
+                    shown, merr);
     float block[6];
     const cJSON *bj = cJSON_GetObjectItemCaseSensitive(t, "block");
     path_key(q, p, "block");
@@ -682,6 +769,8 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
             if (!(block[k + 3] > block[k]))
                 return fail(c, q,
                             "expected [x0, y0, z0, x1, y1, z1] with x1 > x0, y1 > y0, z1 > z0");
+    } else if (has_declared) {
+        memcpy(block, declared, sizeof declared);
     } else {
         vec3 lo, hi;
         mesh_bounds(tex, &lo, &hi);

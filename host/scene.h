@@ -64,6 +64,12 @@ typedef struct Scene {
     uint32_t *tri_tag; /* per triangle: object index | VBCL_TAG_TEXTURE for texture triangles */
 } Scene;
 
+/* The texture generator that objects[i].texture.generate runs (texgen_run_quiet):
+ * set by the program; NULL makes "generate" an error. Kept as a hook so that the
+ * scene parser links without the generator (the fuzzers). */
+typedef int (*SceneTexgenFn)(int argc, char **argv, char *err, size_t errlen);
+extern SceneTexgenFn scene_texgen;
+
 /* Reads and checks a scene file. Returns 0, or 2 (bad input) with a one-line message in
  * err: "FILE:LINE:COL: ..." for JSON syntax, "FILE: json.path: what was expected" for
  * meaning, and the mesh file's own message for a bad mesh. On error *s is freed. */

@@ -83,17 +83,45 @@ static const char usage_project[] =
     "its size; R(X,Y,Z) is the texel nearest to (X, Y) in [0,1]^2, 0 outside.\n"
     "  --image IMG         image to project (any format OpenImageIO reads)\n";
 
-/* Prints "vbcl texgen[ METHOD]: message" and returns 2. */
+/* While texgen_run_quiet runs: where messages go instead of stderr, and no reports. */
+static char *quiet_err;
+static size_t quiet_len;
+
+/* Reports "vbcl texgen[ METHOD]: message" (on stderr, or into the quiet buffer, keeping
+ * the first) and returns status. */
+static int report(int status, const char *method, const char *fmt, va_list ap)
+{
+    char msg[768];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (quiet_err) {
+        if (!quiet_err[0])
+            snprintf(quiet_err, quiet_len, "%s%s%s", method ? method : "", method ? ": " : "", msg);
+    } else {
+        fprintf(stderr, "vbcl texgen%s%s: %s\n", method ? " " : "", method ? method : "", msg);
+    }
+    return status;
+}
+
+/* Reports a bad parameter and returns 2. */
 static int fail(const char *method, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int fail(const char *method, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "vbcl texgen%s%s: ", method ? " " : "", method ? method : "");
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    int rc = report(2, method, fmt, ap);
     va_end(ap);
-    return 2;
+    return rc;
+}
+
+/* Reports a failure while generating or writing (not the parameters' fault): returns 1. */
+static int fail_io(const char *method, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int fail_io(const char *method, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int rc = report(1, method, fmt, ap);
+    va_end(ap);
+    return rc;
 }
 
 static int parse_int(const char *s, long lo, long hi, int *out)
@@ -184,14 +212,11 @@ static int write_texture(const char *method, TexSet *t, const char *out)
     int rc = texset_write(t, out, err, sizeof err);
     uint64_t ntris = 0;
     for (int e = 0; e < t->count; e++) ntris += t->elems[e].ntris;
-    if (rc == 0)
+    if (rc == 0 && !quiet_err)
         printf("%s: %d elements, %llu triangles\n", out, t->count, (unsigned long long)ntris);
     texset_free(t);
     if (rc == -2) return fail(method, "%s", err);
-    if (rc < 0) {
-        fprintf(stderr, "vbcl texgen %s: %s\n", method, err);
-        return 1;
-    }
+    if (rc < 0) return fail_io(method, "%s", err);
     return 0;
 }
 
@@ -255,10 +280,7 @@ static int cmd_bomb(int argc, char **argv)
     char err[512];
     int rc = texgen_bomb(&p, &t, err, sizeof err);
     if (rc == -1) return fail(M, "%s", err);
-    if (rc < 0) {
-        fprintf(stderr, "vbcl texgen bomb: %s\n", err);
-        return 1;
-    }
+    if (rc < 0) return fail_io(M, "%s", err);
     return write_texture(M, &t, out);
 }
 
@@ -358,8 +380,7 @@ static int cmd_deform(int argc, char **argv)
     int rc = texgen_deform(&p, &t, err, sizeof err);
     if (rc == -1) return fail(M, "%s", err);
     if (rc < 0) {
-        fprintf(stderr, "vbcl texgen deform: %s\n", err);
-        return 1;
+        return fail_io("deform", "%s", err);
     }
     return write_texture(M, &t, out);
 }
@@ -456,6 +477,16 @@ static int cmd_project(int argc, char **argv)
     free(rgba);
     printf("%s: %d x %d texels, projected along Z over [0,1]^2\n", image, w, h);
     return 0;
+}
+
+int texgen_run_quiet(int argc, char **argv, char *err, size_t errlen)
+{
+    err[0] = 0;
+    quiet_err = err;
+    quiet_len = errlen;
+    int rc = texgen_main(argc, argv);
+    quiet_err = NULL;
+    return rc;
 }
 
 int texgen_main(int argc, char **argv)

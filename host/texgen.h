@@ -130,4 +130,9 @@ int texgen_projection_load(const char *path, int *width, int *height, float **rg
  * 2 bad parameters or usage (one line on stderr), 1 I/O failure. */
 int texgen_main(int argc, char **argv);
 
+/* texgen_main without output: a message for a non-zero status goes into err
+ * ("METHOD: what was expected"), and nothing is printed. For scenes that generate their
+ * textures inline. */
+int texgen_run_quiet(int argc, char **argv, char *err, size_t errlen);
+
 #endif

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "scene.h"
+#include "texgen.h"
 #include "testutil.h"
 
 const char *tu_vbcl = "./vbcl";
@@ -94,6 +96,7 @@ int main(int argc, char **argv)
             th_set_filter(argv[i]);
     }
     atexit(cleanup);
+    scene_texgen = texgen_run_quiet;
     suite_mesh();
     suite_grid_build();
     suite_scene();

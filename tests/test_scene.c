@@ -1,6 +1,7 @@
 /* test_scene.c — scene loading: defaults, shapes, and one test per class of bad input,
  * each checked for the JSON path (or file:line:col) and what was expected. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "harness.h"
@@ -225,8 +226,70 @@ static void test_scene_parse_grid(void)
     CHECK(scene_parse_grid("x", r) == -1, "text rejected");
 }
 
+/* A texture generated inline from texgen's arguments: generated once into the cache,
+ * read from it the next time; bad arguments give the JSON path and texgen's reason. */
+static void test_scene_texture_generate_inline(void)
+{
+    char cache[512], old[512] = "";
+    const char *prev = getenv("VBCL_CACHE_DIR");
+    if (prev) snprintf(old, sizeof old, "%s", prev);
+    snprintf(cache, sizeof cache, "%s/gencache", tu_tmpdir());
+    setenv("VBCL_CACHE_DIR", cache, 1);
+    const char *json = MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                      "   \"texture\": {\"generate\": \"bomb --count 5 --size "
+                                      "10:20 --seed 3 --level 1\", \"material\": \"m\"}}]}";
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(json, &s, err, sizeof err);
+    CHECK(rc == 0, "inline generation loads: %s", err);
+    if (rc == 0) {
+        CHECK(s.objects[0].ntex_tris == 5 * 80, "5 spheres of 80 triangles, got %u",
+              s.objects[0].ntex_tris);
+        /* the declared block [0, 128]^3 maps onto the host's bounds [-1, 1]^3 */
+        vec3 lo = v3(1e30f, 1e30f, 1e30f), hi = v3(-1e30f, -1e30f, -1e30f);
+        const SceneObject *o = &s.objects[0];
+        for (uint32_t t = o->first_tex_tri; t < o->first_tex_tri + o->ntex_tris; t++)
+            for (int k = 0; k < 3; k++) {
+                lo = v3_min(lo, s.mesh.verts[s.mesh.tris[3 * t + k]]);
+                hi = v3_max(hi, s.mesh.verts[s.mesh.tris[3 * t + k]]);
+            }
+        CHECK(lo.x > -1.4f && hi.x < 1.4f && hi.x - lo.x < 2.6f,
+              "texture mapped by its declared block: x %g..%g", lo.x, hi.x);
+        scene_free(&s);
+    }
+    char listing[1024] = "", cmd[1024];
+    snprintf(cmd, sizeof cmd, "ls %s/textures", cache);
+    tu_run(cmd, listing, sizeof listing);
+    CHECK(strstr(listing, ".ply") != NULL, "generated into the cache: %s", listing);
+    /* the second load reads the cached file: make it unreadable as a mesh to prove it */
+    snprintf(cmd, sizeof cmd, "for f in %s/textures/*.ply; do echo broken > $f; done", cache);
+    tu_run(cmd, NULL, 0);
+    rc = load_text(json, &s, err, sizeof err);
+    CHECK(rc == 2 && strstr(err, "objects[0].texture.generate"),
+          "the cached file is what loads: %s", err);
+    if (rc == 0) scene_free(&s);
+    if (old[0])
+        setenv("VBCL_CACHE_DIR", old, 1);
+    else
+        unsetenv("VBCL_CACHE_DIR");
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \"bomb --count 0\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "--count");
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \"bomb -o x.obj\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "without -o");
+    expect_error(
+        MIN_SCENE_HEAD
+        " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+        "   \"texture\": {\"generate\": \"bomb\", \"file\": \"a.obj\", \"material\": \"m\"}}]}",
+        "objects[0].texture", "not both");
+}
+
 void suite_scene(void)
 {
+    RUN_TEST(test_scene_texture_generate_inline);
     RUN_TEST(test_scene_minimal_defaults);
     RUN_TEST(test_scene_all_shapes_and_transform);
     RUN_TEST(test_scene_bad_syntax);
