@@ -18,12 +18,13 @@ static const struct {
     {VBCL_FEATURE_TEXTURES, "textures", "VBCL_HAS_TEXTURES"},
     {VBCL_FEATURE_ABSORPTION, "absorption", "VBCL_HAS_ABSORPTION"},
     {VBCL_FEATURE_FRESNEL_THESIS, "fresnel-thesis", "VBCL_HAS_FRESNEL_THESIS"},
+    {VBCL_FEATURE_PATTERNS, "patterns", "VBCL_HAS_PATTERNS"},
 };
 
 /* What material m needs from the kernels when an object uses it. */
 static unsigned material_features(const VbMaterial *m)
 {
-    unsigned f = 0;
+    unsigned f = m->pattern >= 0 ? VBCL_FEATURE_PATTERNS : 0;
     if (m->k_local > 0.0f &&
         (m->specular[0] > 0.0f || m->specular[1] > 0.0f || m->specular[2] > 0.0f))
         f |= VBCL_FEATURE_SPECULAR;

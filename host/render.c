@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "kernel_features.h"
+#include "texgen.h"
 
 /* Fills the camera of the frame from the scene's eye, look_at, up and fov. */
 static void frame_camera(const Scene *s, VbCamera *c)
@@ -96,6 +97,72 @@ static cl_mem upload(VbDevice *d, const void *data, size_t bytes, cl_mem_flags f
     return m;
 }
 
+/* Builds the materials' surface patterns (Fourier coefficients, projected images) and
+ * uploads them; sets mats[i].pattern. Returns 0, 2 (a pattern the scene cannot have, the
+ * message naming the material) or 1 (device). */
+static int upload_patterns(Renderer *r, const Scene *s, VbMaterial *mats, char *err, size_t errlen)
+{
+    VbPattern *pats = calloc((size_t)s->nmaterials + 1, sizeof *pats);
+    float *texels = NULL;
+    size_t ntexels = 0; /* in texels of 4 floats */
+    int npats = 0, rc = 0;
+    if (!pats) return 1;
+    for (int i = 0; i < s->nmaterials && !rc; i++) {
+        const ScenePattern *sp = &s->materials[i].pattern;
+        if (!sp->kind) continue;
+        VbPattern *pt = &pats[npats];
+        char perr[512];
+        pt->kind = sp->kind;
+        for (int k = 0; k < 3; k++) {
+            pt->origin[k] = sp->origin[k];
+            pt->inv_size[k] = 1.0f / sp->size[k];
+        }
+        if (sp->kind == VBCL_PATTERN_FOURIER) {
+            if (texgen_fourier_init(&pt->fourier, sp->terms, sp->contrast, sp->freq, sp->seed, perr,
+                                    sizeof perr)) {
+                snprintf(err, errlen, "%s: materials.%s.pattern: %s", s->path, s->materials[i].name,
+                         perr);
+                rc = 2;
+            }
+        } else {
+            int w, h;
+            float *img = NULL;
+            if (texgen_projection_load(sp->image, &w, &h, &img, perr, sizeof perr)) {
+                snprintf(err, errlen, "%s: materials.%s.pattern.image: %s", s->path,
+                         s->materials[i].name, perr);
+                rc = 2;
+            } else {
+                float *grown =
+                    realloc(texels, sizeof(float) * 4 * (ntexels + (size_t)w * (size_t)h));
+                if (!grown) {
+                    rc = 1;
+                    snprintf(err, errlen, "out of memory for the image %s", sp->image);
+                } else {
+                    texels = grown;
+                    memcpy(texels + 4 * ntexels, img, sizeof(float) * 4 * (size_t)w * (size_t)h);
+                    pt->width = w;
+                    pt->height = h;
+                    pt->texel_offset = (unsigned)ntexels;
+                    ntexels += (size_t)w * (size_t)h;
+                }
+            }
+            free(img);
+        }
+        mats[i].pattern = npats++;
+    }
+    if (!rc) {
+        r->patterns = upload(r->dev, pats, sizeof *pats * (size_t)npats, CL_MEM_READ_ONLY);
+        r->texels = upload(r->dev, texels, sizeof(float) * 4 * ntexels, CL_MEM_READ_ONLY);
+        if (!r->patterns || !r->texels) {
+            snprintf(err, errlen, "%s: %s", r->dev->name, clu_error());
+            rc = 1;
+        }
+    }
+    free(pats);
+    free(texels);
+    return rc;
+}
+
 static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
 {
     cl_int rc = clSetKernelArg(k, i, size, val);
@@ -107,9 +174,10 @@ static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
 
 int renderer_set_scene_args(const Renderer *r, cl_kernel k)
 {
-    const cl_mem *m[8] = {&r->frame,     &r->tris,      &r->normals, &r->cell_start,
-                          &r->cell_tris, &r->materials, &r->objects, &r->lights};
-    for (cl_uint i = 0; i < 8; i++)
+    const cl_mem *m[RENDER_SCENE_ARGS] = {&r->frame,     &r->tris,      &r->normals, &r->cell_start,
+                                          &r->cell_tris, &r->materials, &r->objects, &r->lights,
+                                          &r->patterns,  &r->texels};
+    for (cl_uint i = 0; i < RENDER_SCENE_ARGS; i++)
         if (set_arg(k, i, sizeof(cl_mem), m[i])) return -1;
     return 0;
 }
@@ -117,10 +185,11 @@ int renderer_set_scene_args(const Renderer *r, cl_kernel k)
 int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nrays, cl_mem hits,
                             cl_mem media, cl_mem radiance, cl_mem counters)
 {
-    if (renderer_set_scene_args(r, k) || set_arg(k, 8, sizeof(cl_mem), &rays) ||
-        set_arg(k, 9, sizeof(int), &nrays) || set_arg(k, 10, sizeof(cl_mem), &hits) ||
-        set_arg(k, 11, sizeof(cl_mem), &media) || set_arg(k, 12, sizeof(cl_mem), &radiance) ||
-        set_arg(k, 13, sizeof(cl_mem), &counters))
+    const cl_uint a = RENDER_SCENE_ARGS;
+    if (renderer_set_scene_args(r, k) || set_arg(k, a, sizeof(cl_mem), &rays) ||
+        set_arg(k, a + 1, sizeof(int), &nrays) || set_arg(k, a + 2, sizeof(cl_mem), &hits) ||
+        set_arg(k, a + 3, sizeof(cl_mem), &media) || set_arg(k, a + 4, sizeof(cl_mem), &radiance) ||
+        set_arg(k, a + 5, sizeof(cl_mem), &counters))
         return -1;
     return 0;
 }
@@ -200,6 +269,14 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     }
     for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
     mats[s->nmaterials].eta = 1.0f;
+    mats[s->nmaterials].pattern = -1;
+    int prc = upload_patterns(r, s, mats, err, errlen);
+    if (prc) {
+        free(mats);
+        free(objs);
+        renderer_release(r);
+        return prc;
+    }
     mats[s->nmaterials].k_global = 1.0f;
     for (int i = 0; i < s->nobjects; i++) {
         const SceneObject *o = &s->objects[i];
@@ -357,9 +434,9 @@ int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, i
 
 void renderer_release(Renderer *r)
 {
-    cl_mem *mems[] = {&r->tris,    &r->normals,  &r->cell_start, &r->cell_tris, &r->materials,
-                      &r->objects, &r->lights,   &r->frame,      &r->rays,      &r->hits,
-                      &r->media,   &r->radiance, &r->counters};
+    cl_mem *mems[] = {&r->tris,    &r->normals, &r->cell_start, &r->cell_tris, &r->materials,
+                      &r->objects, &r->lights,  &r->patterns,   &r->texels,    &r->frame,
+                      &r->rays,    &r->hits,    &r->media,      &r->radiance,  &r->counters};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) {
             CL_WARN(clReleaseMemObject(*mems[i]));

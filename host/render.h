@@ -29,7 +29,8 @@ typedef struct Renderer {
     VbDevice *dev;
     cl_program program;
     cl_kernel k_camera, k_intersect, k_shading, k_tree; /* k_tree: with transparency */
-    cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, frame;
+    cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels;
+    cl_mem frame;
     cl_mem rays, hits, media, radiance, counters;
     Grid grid;
     VbFrame frame_host;
@@ -49,11 +50,12 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
 int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
                     char *err, size_t errlen);
 
-/* Sets the 8 scene arguments every frame kernel (and every shading probe) starts with:
- * frame, tris, normals, cell_start, cell_tris, materials, objects, lights. */
+/* The scene arguments every frame kernel (and every shading probe) starts with: frame,
+ * tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels. */
+#define RENDER_SCENE_ARGS 10
 int renderer_set_scene_args(const Renderer *r, cl_kernel k);
 
-/* Sets all 14 arguments of a frame kernel: the scene's, then rays, nrays, hits, media,
+/* Sets all arguments of a frame kernel: the scene's, then rays, nrays, hits, media,
  * radiance, counters. */
 int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nrays, cl_mem hits,
                             cl_mem media, cl_mem radiance, cl_mem counters);

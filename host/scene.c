@@ -418,10 +418,75 @@ static int load_lights(Ctx *c, const cJSON *j, Scene *s)
     return 0;
 }
 
+static void join_path(char *out, size_t n, const char *dir, const char *file)
+{
+    if (file[0] == '/' || !dir || !dir[0])
+        snprintf(out, n, "%s", file);
+    else
+        snprintf(out, n, "%s/%s", dir, file);
+}
+
+/* Reads obj[key] as a number (used for all three components) or as [x, y, z]. */
+static int get_scalar_or_vec3(Ctx *c, const cJSON *obj, const char *path, const char *key,
+                              double lo, double hi, float def, float out[3])
+{
+    const cJSON *x = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!x || cJSON_IsNumber(x)) {
+        float a;
+        if (get_float(c, obj, path, key, lo, hi, def, 0, &a)) return -1;
+        out[0] = out[1] = out[2] = a;
+        return 0;
+    }
+    const float d[3] = {def, def, def};
+    return get_vec(c, obj, path, key, 3, lo, hi, d, out);
+}
+
+/* materials.NAME.pattern: a Fourier or projection surface pattern (thesis 2.2.2.3). */
+static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s, ScenePattern *pt)
+{
+    static const char *const keys[] = {"type",  "terms",  "contrast", "frequency", "seed",
+                                       "image", "origin", "size",     NULL};
+    static const float zero[3] = {0, 0, 0};
+    const cJSON *j = cJSON_GetObjectItemCaseSensitive(e, "pattern");
+    if (!j) return 0;
+    char p[PATH_MAX_LEN], q[PATH_MAX_LEN];
+    path_key(p, path, "pattern");
+    if (expect_object(c, j, p) || check_keys(c, j, p, keys)) return -1;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(j, "type");
+    path_key(q, p, "type");
+    if (t && cJSON_IsString(t) && strcmp(t->valuestring, "fourier") == 0)
+        pt->kind = VBCL_PATTERN_FOURIER;
+    else if (t && cJSON_IsString(t) && strcmp(t->valuestring, "projection") == 0)
+        pt->kind = VBCL_PATTERN_PROJECTION;
+    else
+        return fail(c, q, "expected \"fourier\" or \"projection\"");
+    double seed;
+    if (get_int(c, j, p, "terms", 4, 7, 5, 0, &pt->terms) ||
+        get_float(c, j, p, "contrast", 0, 100, 1, 0, &pt->contrast) ||
+        get_scalar_or_vec3(c, j, p, "frequency", 1e-6, 1e6, 1, pt->freq) ||
+        get_num(c, j, p, "seed", 0, 9007199254740992.0, 1, 0, &seed) ||
+        get_vec(c, j, p, "origin", 3, -FLT_MAX, FLT_MAX, zero, pt->origin) ||
+        get_scalar_or_vec3(c, j, p, "size", FLT_MIN, FLT_MAX, 1, pt->size))
+        return -1;
+    pt->seed = (unsigned long long)seed;
+    const cJSON *img = cJSON_GetObjectItemCaseSensitive(j, "image");
+    path_key(q, p, "image");
+    if (pt->kind == VBCL_PATTERN_PROJECTION) {
+        if (!img || !cJSON_IsString(img) || !img->valuestring[0])
+            return fail(c, q, "expected the image file to project");
+        char full[4096];
+        join_path(full, sizeof full, s->dir, img->valuestring);
+        if (!(pt->image = dup_string(full))) return fail(c, NULL, "out of memory");
+    } else if (img) {
+        return fail(c, q, "only a projection pattern takes an image");
+    }
+    return 0;
+}
+
 static int load_materials(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {"ambient",  "diffuse", "specular",   "exponent", "k_local",
-                                       "k_global", "eta",     "extinction", NULL};
+                                       "k_global", "eta",     "extinction", "pattern",  NULL};
     static const float grey[3] = {0.8f, 0.8f, 0.8f}, black[3] = {0, 0, 0};
     if (!j) return fail(c, "materials", "missing (expected an object of named materials)");
     if (expect_object(c, j, "materials")) return -1;
@@ -450,14 +515,12 @@ static int load_materials(Ctx *c, const cJSON *j, Scene *s)
             get_float(c, e, p, "k_global", 0, 1, 0, 0, &g->k_global) ||
             get_float(c, e, p, "eta", 1e-3, 100, 1, 0, &g->eta))
             return -1;
-        const cJSON *x = cJSON_GetObjectItemCaseSensitive(e, "extinction");
-        if (x && cJSON_IsNumber(x)) {
-            float a;
-            if (get_float(c, e, p, "extinction", 0, FLT_MAX, 0, 1, &a)) return -1;
-            g->extinction[0] = g->extinction[1] = g->extinction[2] = a;
-        } else if (get_rgb(c, e, p, "extinction", black, g->extinction)) {
+        s->nmaterials = i + 1; /* from here on scene_free releases its pattern */
+        g->pattern = -1;
+        if (get_scalar_or_vec3(c, e, p, "extinction", 0, FLT_MAX, 0, g->extinction) ||
+            load_pattern(c, e, p, s, &m->pattern))
             return -1;
-        }
+        if (m->pattern.kind) g->pattern = 0; /* has one; the renderer assigns the index */
     }
     s->nmaterials = n;
     return 0;
@@ -502,14 +565,6 @@ static int load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     for (int a = 0; a < 3; a++) m = mat4_mul(mat4_rotate_axis(a, rot[a]), m);
     *xf = mat4_mul(mat4_translate(v3(tr[0], tr[1], tr[2])), m);
     return 0;
-}
-
-static void join_path(char *out, size_t n, const char *dir, const char *file)
-{
-    if (file[0] == '/' || !dir || !dir[0])
-        snprintf(out, n, "%s", file);
-    else
-        snprintf(out, n, "%s/%s", dir, file);
 }
 
 /* Tessellates one object's shape into m (object space). */
@@ -1028,6 +1083,7 @@ void scene_free(Scene *s)
     free(s->dir);
     free(s->output);
     free(s->lights);
+    for (int i = 0; s->materials && i < s->nmaterials; i++) free(s->materials[i].pattern.image);
     free(s->materials);
     free(s->objects);
     free(s->tri_tag);

@@ -14,9 +14,21 @@
 #define SCENE_MAX_TRIANGLES 50000000u
 #define SCENE_NAME_MAX      64
 
+/* A material's surface pattern as the scene gives it; the renderer turns it into a
+ * VbPattern (Fourier coefficients, image texels). */
+typedef struct ScenePattern {
+    int kind; /* 0 none, VBCL_PATTERN_FOURIER or VBCL_PATTERN_PROJECTION */
+    int terms;
+    float contrast, freq[3];
+    unsigned long long seed;
+    char *image; /* projection: path, already joined with the scene's directory */
+    float origin[3], size[3];
+} ScenePattern;
+
 typedef struct SceneMaterial {
     char name[SCENE_NAME_MAX];
     VbMaterial gpu;
+    ScenePattern pattern;
 } SceneMaterial;
 
 typedef struct SceneObject {

@@ -73,8 +73,8 @@ typedef struct ShadowCount {
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
  * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
 VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *light,
-                                   __global const VbMaterial *m, const ShadePoint *sp, uint key,
-                                   TraceCount *tc, ShadowCount *sc)
+                                   __global const VbMaterial *m, float3 diffuse,
+                                   const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
 {
     float3 c = vb_gload3(light->centre);
     float3 radiance = vb_gload3(light->radiance);
@@ -82,7 +82,7 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     float3 to_c = c - sp->p;
     float d2 = dot(to_c, to_c);
     float d = sqrt(d2);
-    float3 kd = vb_gload3(m->diffuse) * (1.0f / VB_PI);
+    float3 kd = diffuse * (1.0f / VB_PI);
 #ifdef VBCL_HAS_SPECULAR
     float3 ks = vb_gload3(m->specular);
     float spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
@@ -175,9 +175,11 @@ VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, Tr
                                    ShadowCount *sc)
 {
     __global const VbMaterial *m = scn->materials + sp->material;
-    float3 col = vb_gload3(m->ambient) * vb_cload3(scn->f->ambient);
+    float3 pattern = scene_pattern_colour(scn, m, sp->p);
+    float3 col = vb_gload3(m->ambient) * pattern * vb_cload3(scn->f->ambient);
+    float3 diffuse = vb_gload3(m->diffuse) * pattern;
     for (uint l = 0; l < scn->f->nlights; l++)
-        col += light_reflect_one(scn, scn->lights + l, m, sp, vb_hash(sp->key * 0x27d4eb2fu + l),
-                                 tc, sc);
+        col += light_reflect_one(scn, scn->lights + l, m, diffuse, sp,
+                                 vb_hash(sp->key * 0x27d4eb2fu + l), tc, sc);
     return m->k_local * col;
 }

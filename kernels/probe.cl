@@ -47,7 +47,8 @@ __kernel void probe_layout(__global uint *out)
     __constant const VbFrame *f, __global const VbTriangle *tris,                                  \
         __global const VbTriNormals *normals, __global const uint *cell_start,                     \
         __global const uint *cell_tris, __global const VbMaterial *materials,                      \
-        __global const VbObject *objects, __global const VbLight *lights
+        __global const VbObject *objects, __global const VbLight *lights,                          \
+        __global const VbPattern *patterns, __global const float *texels
 
 /* points (xyz + unused), normals -> radiance: local shading of material 0 at given points
  * with given normals, seen from along the normal, in the camera's medium. */
@@ -102,4 +103,15 @@ __kernel void probe_hit_matrix(__global const VbTriangle *tris, uint ntris,
             (uchar)tri_intersect(&rs, tri_vertex(tris, k, 0), tri_vertex(tris, k, 1),
                                  tri_vertex(tris, k, 2), r.tmax, &t, &u, &v);
     }
+}
+
+/* points (xyz + unused) -> colours: material `material`'s surface pattern at each point. */
+__kernel void probe_pattern(PROBE_SCENE_ARGS, int material, __global const float *points,
+                            int npoints, __global float *out)
+{
+    int i = get_global_id(0);
+    if (i >= npoints) return;
+    DevScene sc = DEV_SCENE;
+    float3 c = scene_pattern_colour(&sc, materials + material, vload3(0, points + 4 * i));
+    vstore4((float4)(c, 0.0f), i, out);
 }

@@ -25,13 +25,14 @@
     __constant const VbFrame *f, __global const VbTriangle *tris,                                  \
         __global const VbTriNormals *normals, __global const uint *cell_start,                     \
         __global const uint *cell_tris, __global const VbMaterial *materials,                      \
-        __global const VbObject *objects, __global const VbLight *lights, __global VbRay *rays,    \
+        __global const VbObject *objects, __global const VbLight *lights,                          \
+        __global const VbPattern *patterns, __global const float *texels, __global VbRay *rays,    \
         int nrays, __global VbHit *hits, __global VbMedium *media, __global float *radiance,       \
         __global uint *counters
 
 #define DEV_SCENE                                                                                  \
     {                                                                                              \
-        f, tris, normals, cell_start, cell_tris, materials, objects, lights                        \
+        f, tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels      \
     }
 
 /* Primary ray through the continuous image position (px, py), in pixels from the

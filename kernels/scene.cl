@@ -11,7 +11,32 @@ typedef struct DevScene {
     __global const VbMaterial *materials;
     __global const VbObject *objects;
     __global const VbLight *lights;
+    __global const VbPattern *patterns;
+    __global const float *texels; /* projected images, 4 floats per texel */
 } DevScene;
+
+/* The colour a material's surface pattern gives at point p (1 without a pattern):
+ * max(G, 0) for Fourier synthesis, the image's texel for an orthogonal projection (0
+ * outside its unit square), at texture coordinates (p - origin) / size. */
+VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMaterial *m, float3 p)
+{
+#ifdef VBCL_HAS_PATTERNS
+    int pattern = m->pattern;
+    if (pattern < 0) return (float3)(1.0f);
+    __global const VbPattern *pt = sc->patterns + pattern;
+    float3 q = (p - vb_gload3(pt->origin)) * vb_gload3(pt->inv_size);
+    if (pt->kind == VBCL_PATTERN_FOURIER)
+        return (float3)(fmax(0.0f, solidtex_fourier_eval(&pt->fourier, q.x, q.y, q.z)));
+    int t = solidtex_projection_texel(pt->width, pt->height, q.x, q.y);
+    if (t < 0) return (float3)(0.0f);
+    return vload3(0, sc->texels + 4 * ((size_t)pt->texel_offset + (size_t)t));
+#else
+    (void)sc;
+    (void)m;
+    (void)p;
+    return (float3)(1.0f);
+#endif
+}
 
 /* Closest hit of (org, dir) within tmax, through the grid. */
 VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, float tmax,

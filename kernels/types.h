@@ -5,6 +5,7 @@
 #define VBCL_TYPES_H
 
 #include "compat.h"
+#include "solidtex.h"
 
 /* Feature bits: which code a scene needs. The host turns them into -D options
  * (features_build_options in host/kernel_features.c); kernels test the macros. */
@@ -15,7 +16,12 @@
 #define VBCL_FEATURE_TEXTURES       (1u << 4) /* some object carries a volume texture */
 #define VBCL_FEATURE_ABSORPTION     (1u << 5) /* some dielectric absorbs (extinction > 0) */
 #define VBCL_FEATURE_FRESNEL_THESIS (1u << 6) /* split by thesis eq. 9, not Fresnel */
-#define VBCL_FEATURE_COUNT          7
+#define VBCL_FEATURE_PATTERNS       (1u << 7) /* some material has a surface pattern */
+#define VBCL_FEATURE_COUNT          8
+
+/* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
+#define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
+#define VBCL_PATTERN_PROJECTION 2 /* orthogonal projection of an image along Z */
 
 /* Volume textures: at most this many objects per scene carry one; the medium state keeps
  * an 8-bit count of elements per textured object. */
@@ -85,9 +91,24 @@ typedef struct VbMaterial {
     float extinction[4]; /* rgb absorption coefficient alpha, 1/scene unit (optics issue) */
     float exponent;      /* specular (Blinn-Phong) exponent */
     float k_local;       /* weight of local shading */
-    float k_global;      /* weight of reflected + transmitted light (optics issue) */
-    float eta;           /* refractive index (optics issue) */
+    float k_global;      /* weight of reflected + transmitted light */
+    float eta;           /* refractive index */
+    int pattern;         /* index into the patterns, or -1 */
+    int pad[3];
 } VbMaterial;
+
+/* A material's surface pattern: at a hit point p, texture coordinates
+ * q = (p - origin) * inv_size, and the diffuse and ambient colours are scaled by
+ * max(G(q), 0) (Fourier) or by the image's texel at (q.x, q.y) (projection, 0 outside
+ * the unit square, as the thesis's R). */
+typedef struct VbPattern {
+    int kind;                  /* VBCL_PATTERN_* */
+    int width, height;         /* projection: image size */
+    unsigned int texel_offset; /* projection: first texel (4 floats each) in the texels */
+    float origin[4];
+    float inv_size[4];
+    VbFourier fourier; /* VBCL_PATTERN_FOURIER */
+} VbPattern;
 
 /* An object as the kernels see it: its material, and for a host its volume texture. */
 typedef struct VbObject {
@@ -155,7 +176,10 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbRay, sample) == 28, ray_sample);
 VBCL_STATIC_ASSERT(sizeof(VbHit) == 16, hit_size);
 VBCL_STATIC_ASSERT(sizeof(VbTriangle) == 48, triangle_size);
 VBCL_STATIC_ASSERT(sizeof(VbTriNormals) == 48, trinormals_size);
-VBCL_STATIC_ASSERT(sizeof(VbMaterial) == 80, material_size);
+VBCL_STATIC_ASSERT(sizeof(VbMaterial) == 96, material_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, pattern) == 80, material_pattern);
+VBCL_STATIC_ASSERT(sizeof(VbPattern) == 48 + 240, pattern_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbPattern, fourier) == 48, pattern_fourier);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, exponent) == 64, material_exponent);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, eta) == 76, material_eta);
 VBCL_STATIC_ASSERT(sizeof(VbLight) == 32, light_size);

@@ -115,8 +115,9 @@ int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const 
     if (rc != CL_SUCCESS) return -1;
     CHECK(renderer_set_scene_args(&fx->r, k) == 0, "scene arguments: %s", clu_error());
     for (int i = 0; i < nargs; i++) {
-        rc = clSetKernelArg(k, (cl_uint)(8 + i), sizes[i], vals[i]);
-        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, 8 + i, clu_error_name(rc));
+        rc = clSetKernelArg(k, (cl_uint)(RENDER_SCENE_ARGS + i), sizes[i], vals[i]);
+        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, RENDER_SCENE_ARGS + i,
+              clu_error_name(rc));
     }
     size_t global = (n + 63) / 64 * 64;
     rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);

@@ -104,6 +104,7 @@ int main(int argc, char **argv)
     suite_cli();
     suite_kernels();
     suite_optics();
+    suite_patterns();
     suite_stability();
     suite_render();
     return th_summary();

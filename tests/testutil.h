@@ -31,6 +31,7 @@ void suite_texgen(void);
 void suite_cli(void);
 void suite_kernels(void);
 void suite_optics(void);
+void suite_patterns(void);
 void suite_stability(void);
 void suite_render(void);
 

@@ -1,0 +1,154 @@
+/* test_patterns.c — surface-colour solid textures in the kernel (thesis 2.2.2.3): Gardner's
+ * Fourier synthesis equals the host's evaluation, and an orthogonal projection returns the
+ * image's own texels, through a probe and through a whole render. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fixture.h"
+#include "harness.h"
+#include "image_io.h"
+#include "texgen.h"
+#include "testutil.h"
+
+/* A 4 x 2 image with distinct texels, written as EXR (exact floats). */
+static const float image[8][3] = {{0.1f, 0.2f, 0.3f}, {0.4f, 0.5f, 0.6f},   {0.7f, 0.8f, 0.9f},
+                                  {1.0f, 0.0f, 0.5f}, {0.25f, 0.5f, 0.75f}, {0.9f, 0.1f, 0.2f},
+                                  {0.3f, 0.6f, 0.0f}, {0.05f, 0.95f, 0.45f}};
+
+static const char *write_image(void)
+{
+    static char path[512];
+    float rgba[8 * 4];
+    for (int i = 0; i < 8; i++) {
+        for (int c = 0; c < 3; c++) rgba[4 * i + c] = image[i][c];
+        rgba[4 * i + 3] = 1;
+    }
+    char err[256];
+    snprintf(path, sizeof path, "%s/pattern.exr", tu_tmpdir());
+    CHECK(image_write(path, 4, 2, rgba, 0, err, sizeof err) == 0, "%s", err);
+    return path;
+}
+
+#define PATTERN_SCENE                                                                              \
+    "{\"camera\": {\"eye\": [0.5, 0.5, 5], \"look_at\": [0.5, 0.5, 0], \"fov\": 12},"              \
+    " \"image\": {\"width\": 40, \"height\": 20},"                                                 \
+    " \"render\": {\"ambient\": [1, 1, 1]},"                                                       \
+    " \"materials\": {\"plain\": {},"                                                              \
+    "   \"g\": {\"pattern\": {\"type\": \"fourier\", \"terms\": 6, \"contrast\": 0.5,"             \
+    "          \"frequency\": [2, 3, 4], \"seed\": 7, \"origin\": [1, 2, 3], \"size\": 2}},"       \
+    "   \"img\": {\"diffuse\": [1, 1, 1], \"pattern\": {\"type\": \"projection\", \"image\": "     \
+    "\"%s\"}}},"                                                                                   \
+    " \"objects\": [{\"shape\": \"quad\", \"size\": [2, 1], \"material\": \"img\","                \
+    "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0.5, 0.5, 0]}}]}"
+
+/* In the kernel, G (clamped at 0) matches the host's solidtex_fourier_eval at texture
+ * coordinates (p - origin) / size; the projection returns each texel at its centre and 0
+ * outside the unit square. */
+static void test_patterns_probe_matches_host(void)
+{
+    char json[4096];
+    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
+    Fixture fx;
+    if (fixture_open(&fx, json)) return;
+    enum { N = 64 };
+    float pts[N * 4], out[N * 4];
+    unsigned seed = 5;
+    for (int i = 0; i < N; i++) {
+        for (int k = 0; k < 3; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            pts[4 * i + k] = (float)(seed >> 8) / 16777216.0f * 6.0f - 3.0f;
+        }
+        pts[4 * i + 3] = 0;
+    }
+    cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
+    int n = N, mat = 1; /* "g" */
+    const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *v[] = {&mat, &mp, &n, &mo};
+    fixture_run_probe(&fx, "probe_pattern", N, 4, sz, v);
+    read_buffer(mo, out, sizeof out);
+    VbFourier four;
+    char err[256];
+    const float freq[3] = {2, 3, 4};
+    CHECK(texgen_fourier_init(&four, 6, 0.5f, freq, 7, err, sizeof err) == 0, "%s", err);
+    double worst = 0, lo = 1, hi = 0;
+    for (int i = 0; i < N; i++) {
+        float q[3] = {(pts[4 * i] - 1) / 2, (pts[4 * i + 1] - 2) / 2, (pts[4 * i + 2] - 3) / 2};
+        double want = fmax(0.0, solidtex_fourier_eval(&four, q[0], q[1], q[2]));
+        worst = fmax(worst, fabs(out[4 * i] - want));
+        lo = fmin(lo, out[4 * i]);
+        hi = fmax(hi, out[4 * i]);
+        CHECK(out[4 * i] == out[4 * i + 1] && out[4 * i] == out[4 * i + 2], "grey");
+    }
+    fprintf(stderr, "    Fourier: worst |kernel - host| %.2e over %d points, range %.3f..%.3f\n",
+            worst, N, lo, hi);
+    CHECK(worst < 1e-5, "kernel G equals the host's within 1e-5 (%.3g)", worst);
+    CHECK(hi > lo + 0.05, "the pattern varies (%.3f..%.3f)", lo, hi);
+    /* projection: texel centres of a 4 x 2 image over the unit square, and two points outside */
+    float tp[10 * 4];
+    for (int t = 0; t < 8; t++) {
+        int col = t % 4, row = t / 4;
+        tp[4 * t] = (col + 0.5f) / 4, tp[4 * t + 1] = 1 - (row + 0.5f) / 2, tp[4 * t + 2] = 0.3f;
+    }
+    tp[32] = 1.2f, tp[33] = 0.5f, tp[36] = 0.5f, tp[37] = -0.1f;
+    cl_mem mt = buffer(tp, sizeof tp), mq = buffer(NULL, sizeof tp);
+    n = 10;
+    mat = 2; /* "img" */
+    const void *v2[] = {&mat, &mt, &n, &mq};
+    fixture_run_probe(&fx, "probe_pattern", 10, 4, sz, v2);
+    float got[10 * 4];
+    read_buffer(mq, got, sizeof got);
+    for (int t = 0; t < 8; t++)
+        for (int c = 0; c < 3; c++)
+            CHECK(got[4 * t + c] == image[t][c], "texel %d channel %d: %g, image %g", t, c,
+                  got[4 * t + c], image[t][c]);
+    CHECK(got[32] == 0 && got[36] == 0, "zero outside the unit square (%g, %g)", got[32], got[36]);
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mo);
+    clReleaseMemObject(mt);
+    clReleaseMemObject(mq);
+    fixture_close(&fx);
+}
+
+/* A whole render: a quad facing the camera carries the projected image; lit only by an
+ * ambient light of 1, each pixel's colour is its texel's. */
+static void test_patterns_render_projection(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    char json[4096], out[512], cmd[2048], log[4096], err[256];
+    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
+    const char *scene = tu_write_file("pattern_scene.json", json);
+    snprintf(out, sizeof out, "%s/pattern_render.exr", tu_tmpdir());
+    snprintf(cmd, sizeof cmd, "%s %s -q -o %s", tu_vbcl, scene, out);
+    int rc = tu_run(cmd, log, sizeof log);
+    CHECK(rc == 0, "renders: %s", log);
+    int w, h;
+    float *px;
+    if (rc || image_read(out, &w, &h, &px, err, sizeof err)) return;
+    /* the quad spans x in [-0.5, 1.5], y in [0, 1]; sample the pixel over each texel centre */
+    double half = 5 * tan(6 * M_PI / 180), aspect = (double)w / h;
+    int ok = 0;
+    for (int t = 0; t < 8; t++) {
+        double x = (t % 4 + 0.5) / 4, y = 1 - (t / 4 + 0.5) / 2;
+        int col = (int)((((x - 0.5) / (half * aspect)) + 1) / 2 * w),
+            row = (int)((1 - (y - 0.5) / half) / 2 * h);
+        const float *c = px + 4 * ((size_t)row * w + col);
+        int match = fabsf(c[0] - image[t][0]) < 1e-5f && fabsf(c[1] - image[t][1]) < 1e-5f &&
+                    fabsf(c[2] - image[t][2]) < 1e-5f;
+        ok += match;
+        CHECK(match, "texel %d at pixel (%d, %d): %g %g %g, image %g %g %g", t, col, row, c[0],
+              c[1], c[2], image[t][0], image[t][1], image[t][2]);
+    }
+    fprintf(stderr, "    projection render: %d of 8 texel centres exact\n", ok);
+    free(px);
+}
+
+void suite_patterns(void)
+{
+    RUN_TEST(test_patterns_probe_matches_host);
+    RUN_TEST(test_patterns_render_projection);
+}
