@@ -287,8 +287,27 @@ static void test_scene_texture_generate_inline(void)
         "objects[0].texture", "not both");
 }
 
+/* Every example scene in the repository loads (meshes, textures and all). */
+static void test_scene_examples_load(void)
+{
+    char list[16384] = "";
+    tu_run("ls scenes/*.json scenes/*/*.json 2>/dev/null", list, sizeof list);
+    int n = 0;
+    for (char *line = strtok(list, "\n"); line; line = strtok(NULL, "\n")) {
+        Scene s;
+        char err[1024] = "";
+        int rc = scene_load(line, &s, err, sizeof err);
+        CHECK(rc == 0, "%s does not load: %s", line, err);
+        if (rc == 0) scene_free(&s);
+        n++;
+    }
+    fprintf(stderr, "    %d example scenes\n", n);
+    CHECK(n >= 10, "found the example scenes (%d)", n);
+}
+
 void suite_scene(void)
 {
+    RUN_TEST(test_scene_examples_load);
     RUN_TEST(test_scene_texture_generate_inline);
     RUN_TEST(test_scene_minimal_defaults);
     RUN_TEST(test_scene_all_shapes_and_transform);
