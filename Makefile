@@ -35,7 +35,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench-grid stress oclgrind fuzz
+.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -106,6 +106,11 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 
+# Anti-aliasing: render time against error for adaptive thresholds and uniform supersampling
+# (docs/architecture.md, "Measurements"); CSV and plot in bench-out/.
+bench: vbcl
+	scripts/bench_aa.py
+
 # Render time against the auto-grid density (docs/architecture.md, "Measurements").
 bench-grid: vbcl
 	scripts/bench_grid.sh
@@ -125,6 +130,7 @@ OCLGRIND_FLAGS ?= --check-api --data-races
 oclgrind: $(BUILD)/vbcl
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny.json "$(OCLGRIND_FLAGS)"
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
+	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_aa.json "$(OCLGRIND_FLAGS)"
 
 # libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
 # run for FUZZ_SECONDS each from the seed corpus in tests/fuzz/corpus/ (docs/testing.md).

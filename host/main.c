@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "aa.h"
 #include "clu.h"
 #include "kernel_features.h"
 #include "image_io.h"
@@ -36,6 +37,12 @@ static const char usage_text[] =
     "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
     "      --fresnel exact|thesis  energy split at interfaces: Fresnel, or thesis eq. 9\n"
     "      --exposure STOPS     scale the image by 2^STOPS before writing\n"
+    "      --aa THRESHOLD       adaptive anti-aliasing: refine pixels whose contrast\n"
+    "                           |a-b|/(a+b) with a neighbour exceeds THRESHOLD (0..1; 0 off)\n"
+    "      --aa-max-level L     deepest refinement, 2^L x 2^L samples per pixel (1..4)\n"
+    "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
+    "      --aa-map FILE        write each pixel's refinement level as a heat map\n"
+    "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
     "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
@@ -50,9 +57,9 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid, *fresnel;
-    int width, height, shadow_samples, depth;
-    double grid_density, exposure, min_weight;
+    const char *scene, *output, *device, *grid, *fresnel, *aa_map;
+    int width, height, shadow_samples, depth, aa_max_level, ssaa;
+    double grid_density, exposure, min_weight, aa;
     int have_exposure;
     int list_devices, stats, quiet;
 } Options;
@@ -101,7 +108,8 @@ static int parse_args(int argc, char **argv, Options *o)
 {
     memset(o, 0, sizeof *o);
     o->width = o->height = o->shadow_samples = o->depth = -1;
-    o->grid_density = o->min_weight = -1;
+    o->grid_density = o->min_weight = o->aa = -1;
+    o->aa_max_level = o->ssaa = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -149,6 +157,18 @@ static int parse_args(int argc, char **argv, Options *o)
             NEEDS_VALUE;
             if (parse_double(a, val, -30, 30, &o->exposure)) return 2;
             o->have_exposure = 1;
+        } else if (!strcmp(a, "--aa")) {
+            NEEDS_VALUE;
+            if (parse_double(a, val, 0, 1, &o->aa)) return 2;
+        } else if (!strcmp(a, "--aa-max-level")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, VBCL_AA_MAX_LEVEL, &o->aa_max_level)) return 2;
+        } else if (!strcmp(a, "--ssaa")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, 16, &o->ssaa)) return 2;
+        } else if (!strcmp(a, "--aa-map")) {
+            NEEDS_VALUE;
+            o->aa_map = val;
         } else if (!strcmp(a, "--device")) {
             NEEDS_VALUE;
             o->device = val;
@@ -194,7 +214,8 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
 {
     char feat[128];
     features_describe(st->features, feat, sizeof feat);
-    unsigned long long rays = st->rays_primary + st->rays_shadow + st->reflected + st->transmitted;
+    unsigned long long rays =
+        st->rays_primary + st->rays_refine + st->rays_shadow + st->reflected + st->transmitted;
     double kernel_ms = st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms;
     unsigned strata = r->frame_host.shadow_strata;
     fprintf(stderr, "scene       %s: %d objects, %u triangles, %d materials, %d lights\n", s->path,
@@ -211,9 +232,10 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
         st->grid_ms, r->grid.tris_per_cell_mean, r->grid.tris_per_cell_max,
         100.0 * r->grid.empty_fraction, r->grid.tris_per_nonempty_mean, r->grid.refinements);
     fprintf(stderr,
-            "rays        primary %llu, shadow %llu (%u per light per point; %llu skipped: light "
-            "behind the surface), total %llu\n",
-            st->rays_primary, st->rays_shadow, strata * strata, st->shadow_skipped, rays);
+            "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point; %llu "
+            "skipped: light behind the surface), total %llu\n",
+            st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata, st->shadow_skipped,
+            rays);
     if (st->features & VBCL_FEATURE_TRANSPARENCY) {
         fprintf(
             stderr,
@@ -236,7 +258,25 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
     fprintf(stderr, "work        %.2f cells visited and %.2f triangles tested per ray\n",
             rays ? (double)st->traversal_steps / (double)rays : 0.0,
             rays ? (double)st->tri_tests / (double)rays : 0.0);
-    fprintf(stderr, "samples     1.00 per pixel (mean), 1 (max)\n");
+    long npix = (long)s->width * s->height;
+    fprintf(stderr, "samples     %.2f per pixel (mean), %u (max), %.4f of uniform 16x16\n",
+            (double)st->samples / (double)npix, st->samples_max,
+            (double)st->samples / (256.0 * (double)npix));
+    if (s->ssaa > 1)
+        fprintf(stderr, "anti-alias  uniform %dx%d supersampling, box window\n", s->ssaa, s->ssaa);
+    else if (s->aa_threshold > 0.0f) {
+        fprintf(stderr,
+                "anti-alias  adaptive, threshold %g, max level %d, %d rounds; pixels refined to "
+                "level",
+                (double)s->aa_threshold, s->aa_max_level, st->aa_rounds);
+        for (int l = 1; l <= s->aa_max_level; l++)
+            fprintf(stderr, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
+                    l < s->aa_max_level ? "," : "\n");
+        fprintf(stderr,
+                "aa time     contrast %.1f ms, refine %.1f ms (sample generation and tracing, "
+                "included in the stages below), reconstruct %.1f ms (device)\n",
+                st->aa_contrast_ms, st->aa_refine_ms, st->aa_reconstruct_ms);
+    }
     fprintf(
         stderr,
         "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f ms, "
@@ -246,6 +286,25 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
         st->readback_ms, st->render_ms, write_ms, total_ms);
     fprintf(stderr, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
             kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
+}
+
+/* Writes each pixel's refinement level as a heat map (aa_level_colour). */
+static int write_aa_map(const char *path, const Scene *s, const int *levels, char *err,
+                        size_t errlen)
+{
+    size_t npix = (size_t)s->width * (size_t)s->height;
+    float *map = malloc(sizeof(float) * 4 * npix);
+    if (!map) {
+        snprintf(err, errlen, "out of memory for the anti-aliasing map");
+        return -1;
+    }
+    for (size_t i = 0; i < npix; i++) {
+        aa_level_colour(levels[i], map + 4 * i);
+        map[4 * i + 3] = 1.0f;
+    }
+    int rc = image_write(path, s->width, s->height, map, 0.0f, err, errlen);
+    free(map);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -271,6 +330,20 @@ int main(int argc, char **argv)
     if (o.have_exposure) s.exposure = (float)o.exposure;
     if (o.depth > 0) s.max_depth = o.depth;
     if (o.min_weight >= 0) s.min_weight = (float)o.min_weight;
+    if (o.aa >= 0) s.aa_threshold = (float)o.aa;
+    if (o.aa_max_level > 0) s.aa_max_level = o.aa_max_level;
+    if (o.ssaa > 0) s.ssaa = o.ssaa;
+    if (s.ssaa > 1 && s.aa_threshold > 0.0f) {
+        if (o.aa > 0) {
+            scene_free(&s);
+            return usage_error("%s", "--aa and --ssaa exclude each other");
+        }
+        s.aa_threshold = 0.0f; /* --ssaa overrides the scene's render.aa */
+    }
+    if (o.aa_map && !(s.aa_threshold > 0.0f)) {
+        scene_free(&s);
+        return usage_error("%s", "--aa-map needs adaptive anti-aliasing (--aa or render.aa)");
+    }
     if (o.fresnel)
         s.fresnel = strcmp(o.fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o.grid && scene_parse_grid(o.grid, s.grid_res)) {
@@ -288,7 +361,8 @@ int main(int argc, char **argv)
         rc = 1;
         goto done_scene;
     }
-    if (image_check_path(out, err, sizeof err)) {
+    if (image_check_path(out, err, sizeof err) ||
+        (o.aa_map && image_check_path(o.aa_map, err, sizeof err))) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 2;
         goto done_scene;
@@ -322,10 +396,16 @@ int main(int argc, char **argv)
         rc = 1;
         goto done_renderer;
     }
+    if (o.aa_map && r.aa_levels && write_aa_map(o.aa_map, &s, r.aa_levels, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        rc = 1;
+        goto done_renderer;
+    }
     double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
     if (o.stats) print_stats(&s, &dev, &r, &st, write_ms, total_ms);
     if (!o.quiet) {
-        unsigned long long rays = st.rays_primary + st.rays_shadow + st.reflected + st.transmitted;
+        unsigned long long rays =
+            st.rays_primary + st.rays_refine + st.rays_shadow + st.reflected + st.transmitted;
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s.width, s.height, total_ms / 1000.0, s.mesh.ntris, rays,
                st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev.name);

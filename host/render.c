@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "aa.h"
 #include "kernel_features.h"
 #include "texgen.h"
 
@@ -194,6 +195,22 @@ int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nra
     return 0;
 }
 
+int renderer_fit_local_size(Renderer *r, cl_kernel k)
+{
+    size_t max = 0;
+    if (!k) return 0;
+    if (clGetKernelWorkGroupInfo(k, r->dev->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof max, &max,
+                                 NULL) != CL_SUCCESS ||
+        max < r->local_size)
+        r->local_size = 0;
+    return 0;
+}
+
+const size_t *renderer_local(const Renderer *r, size_t global)
+{
+    return r->local_size && global % r->local_size == 0 ? &r->local_size : NULL;
+}
+
 int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
                   RenderStats *st, char *err, size_t errlen)
 {
@@ -225,6 +242,11 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
         r->k_tree = clCreateKernel(r->program, "tree_trace_secondary", &rc);
         CL_CHECK_ERR(rc, "clCreateKernel(tree_trace_secondary)", fail);
     }
+
+    r->local_size = dev->max_wg >= 64 ? 64 : 0;
+    renderer_fit_local_size(r, r->k_intersect);
+    renderer_fit_local_size(r, r->k_shading);
+    renderer_fit_local_size(r, r->k_tree);
 
     double t0 = clu_now_ms();
     VbTriangle *tris = pack_triangles(s);
@@ -321,10 +343,13 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     while (tile > 256 && tile * per_pixel > (1L << 24)) tile /= 2;
     if (tile > npix) tile = npix;
     r->tile_pixels = (int)tile;
-    r->rays = upload(dev, NULL, sizeof(VbRay) * (size_t)tile, CL_MEM_READ_WRITE);
-    r->hits = upload(dev, NULL, sizeof(VbHit) * (size_t)tile, CL_MEM_READ_WRITE);
-    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)tile, CL_MEM_READ_WRITE);
-    r->media = upload(dev, NULL, sizeof(VbMedium) * (size_t)tile, CL_MEM_READ_WRITE);
+    /* supersampling batches hold at least one pixel's 16x16 samples */
+    long cap = tile < AA_MIN_BATCH_RAYS ? AA_MIN_BATCH_RAYS : tile;
+    r->ray_capacity = (int)cap;
+    r->rays = upload(dev, NULL, sizeof(VbRay) * (size_t)cap, CL_MEM_READ_WRITE);
+    r->hits = upload(dev, NULL, sizeof(VbHit) * (size_t)cap, CL_MEM_READ_WRITE);
+    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)cap, CL_MEM_READ_WRITE);
+    r->media = upload(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
     r->counters = upload(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
     if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->media || !r->counters) goto fail;
     st->upload_ms = clu_now_ms() - t0;
@@ -346,109 +371,151 @@ static void progress_report(double t_start, long done, long total, int *shown)
     *shown = 1;
 }
 
-int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
-                    char *err, size_t errlen)
+int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
+{
+    VbDevice *d = r->dev;
+    cl_event ev[3] = {0};
+    cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
+    size_t global = ((size_t)n + 63) / 64 * 64;
+    int rc = -1;
+    CL_CHECK(
+        clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0, NULL, NULL),
+        done);
+    /* first interfaces, local shading, and with dielectrics the ray trees */
+    cl_kernel stages[3] = {r->k_intersect, r->k_shading, r->k_tree};
+    for (int k = 0; k < 3; k++) {
+        if (!stages[k]) continue;
+        if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
+                                    r->counters))
+            goto done;
+        CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global,
+                                        renderer_local(r, global), 0, NULL, &ev[k]),
+                 done);
+    }
+    CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
+                                 NULL),
+             done);
+    double ms[3] = {clu_event_ms(ev[0]), clu_event_ms(ev[1]), ev[2] ? clu_event_ms(ev[2]) : 0.0};
+    st->intersect_ms += ms[0];
+    st->shading_ms += ms[1];
+    st->tree_ms += ms[2];
+    if (trace_ms) *trace_ms += ms[0] + ms[1] + ms[2];
+    st->rays_primary += (unsigned long long)n;
+    st->rays_shadow += counts[VBCL_COUNT_SHADOW];
+    st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
+    st->traversal_steps += counts[VBCL_COUNT_TRAVERSAL_STEPS];
+    st->tri_tests += counts[VBCL_COUNT_TRI_TESTS];
+    st->reflected += counts[VBCL_COUNT_REFLECTED];
+    st->transmitted += counts[VBCL_COUNT_TRANSMITTED];
+    st->pruned += counts[VBCL_COUNT_PRUNED];
+    st->depth_cut += counts[VBCL_COUNT_DEPTH_CUT];
+    st->tir += counts[VBCL_COUNT_TIR];
+    st->pass_through += counts[VBCL_COUNT_PASS_THROUGH];
+    st->interfaces += counts[VBCL_COUNT_INTERFACES];
+    st->energy_errors += counts[VBCL_COUNT_ENERGY_ERRORS];
+    st->by_depth[0] += (unsigned long long)n;
+    for (int k = 1; k < VBCL_COUNT_DEPTH_BINS; k++)
+        st->by_depth[k] += counts[VBCL_COUNT_DEPTH0 + k];
+    rc = 0;
+done:
+    for (int i = 0; i < 3; i++)
+        if (ev[i]) clReleaseEvent(ev[i]);
+    return rc;
+}
+
+/* Pass 0: one ray through the centre of each pixel, tile by tile, into rgba. */
+static int render_pixel_centres(Renderer *r, const Scene *s, float *rgba, RenderStats *st,
+                                int progress, char *err, size_t errlen)
 {
     VbDevice *d = r->dev;
     VbFrame *f = &r->frame_host;
     long npix = (long)s->width * s->height;
-    float *tile_rgba = malloc(sizeof(float) * 4 * (size_t)r->tile_pixels);
-    if (!tile_rgba) {
-        snprintf(err, errlen, "out of memory");
-        return 1;
-    }
     double t_start = clu_now_ms();
     int shown = 0;
-    clu_error_clear();
     for (long first = 0; first < npix; first += r->tile_pixels) {
         int n = (int)((npix - first) < r->tile_pixels ? (npix - first) : r->tile_pixels);
         f->first_pixel = (int)first;
         f->tile_pixels = n;
-        cl_event ev[5] = {0};
-        cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
+        cl_event ev[2] = {0};
         size_t global = ((size_t)n + 63) / 64 * 64;
         CL_CHECK(clEnqueueWriteBuffer(d->queue, r->frame, CL_FALSE, 0, sizeof *f, f, 0, NULL, NULL),
                  fail);
-        CL_CHECK(clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0,
-                                      NULL, NULL),
-                 fail);
-        /* camera rays, first interfaces, local shading, and with dielectrics the ray trees */
-        cl_kernel stages[4] = {r->k_camera, r->k_intersect, r->k_shading, r->k_tree};
-        for (int k = 0; k < 4; k++) {
-            if (!stages[k]) continue;
-            if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
-                                        r->counters))
-                goto fail;
-            CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global, NULL, 0, NULL,
-                                            &ev[k]),
-                     fail);
-        }
-        CL_CHECK(clEnqueueReadBuffer(d->queue, r->radiance, CL_FALSE, 0,
-                                     sizeof(float) * 4 * (size_t)n, tile_rgba, 0, NULL, &ev[4]),
-                 fail);
-        CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0,
-                                     NULL, NULL),
+        if (renderer_set_frame_args(r, r->k_camera, r->rays, n, r->hits, r->media, r->radiance,
+                                    r->counters))
+            goto fail;
+        CL_CHECK(
+            clEnqueueNDRangeKernel(d->queue, r->k_camera, 1, NULL, &global, NULL, 0, NULL, &ev[0]),
+            fail);
+        if (renderer_trace_rays(r, n, st, NULL)) goto fail;
+        CL_CHECK(clEnqueueReadBuffer(d->queue, r->radiance, CL_TRUE, 0,
+                                     sizeof(float) * 4 * (size_t)n, rgba + 4 * first, 0, NULL,
+                                     &ev[1]),
                  fail);
         st->camera_ms += clu_event_ms(ev[0]);
-        st->intersect_ms += clu_event_ms(ev[1]);
-        st->shading_ms += clu_event_ms(ev[2]);
-        if (ev[3]) st->tree_ms += clu_event_ms(ev[3]);
-        st->readback_ms += clu_event_ms(ev[4]);
-        for (int i = 0; i < 5; i++)
+        st->readback_ms += clu_event_ms(ev[1]);
+        for (int i = 0; i < 2; i++)
             if (ev[i]) clReleaseEvent(ev[i]);
-        memcpy(rgba + 4 * first, tile_rgba, sizeof(float) * 4 * (size_t)n);
-        st->rays_primary += (unsigned long long)n;
-        st->rays_shadow += counts[VBCL_COUNT_SHADOW];
-        st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
-        st->traversal_steps += counts[VBCL_COUNT_TRAVERSAL_STEPS];
-        st->tri_tests += counts[VBCL_COUNT_TRI_TESTS];
-        st->reflected += counts[VBCL_COUNT_REFLECTED];
-        st->transmitted += counts[VBCL_COUNT_TRANSMITTED];
-        st->pruned += counts[VBCL_COUNT_PRUNED];
-        st->depth_cut += counts[VBCL_COUNT_DEPTH_CUT];
-        st->tir += counts[VBCL_COUNT_TIR];
-        st->pass_through += counts[VBCL_COUNT_PASS_THROUGH];
-        st->interfaces += counts[VBCL_COUNT_INTERFACES];
-        st->energy_errors += counts[VBCL_COUNT_ENERGY_ERRORS];
-        st->by_depth[0] += (unsigned long long)n;
-        for (int k = 1; k < VBCL_COUNT_DEPTH_BINS; k++)
-            st->by_depth[k] += counts[VBCL_COUNT_DEPTH0 + k];
         st->tiles++;
         if (progress) progress_report(t_start, first + n, npix, &shown);
         continue;
     fail:
-        for (int i = 0; i < 5; i++)
+        for (int i = 0; i < 2; i++)
             if (ev[i]) clReleaseEvent(ev[i]);
         if (shown) fputc('\n', stderr);
         snprintf(err, errlen, "%s: %s", d->name, clu_error());
-        free(tile_rgba);
         return 1;
     }
     if (shown)
         fprintf(stderr, "\rvbcl: rendering 100%% (%.1f s)%30s\n", (clu_now_ms() - t_start) / 1000.0,
                 "");
-    st->render_ms = clu_now_ms() - t_start;
-    free(tile_rgba);
     return 0;
+}
+
+int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
+                    char *err, size_t errlen)
+{
+    long npix = (long)s->width * s->height;
+    double t_start = clu_now_ms();
+    int rc;
+    clu_error_clear();
+    free(r->aa_levels);
+    r->aa_levels = NULL;
+    if (s->ssaa > 1) {
+        rc = aa_supersample(r, s, s->ssaa, rgba, st, err, errlen);
+    } else {
+        rc = render_pixel_centres(r, s, rgba, st, progress, err, errlen);
+        st->samples = (unsigned long long)npix;
+        st->samples_max = 1;
+        unsigned long long centres = st->rays_primary;
+        if (!rc && s->aa_threshold > 0.0f) rc = aa_refine(r, s, rgba, st, err, errlen);
+        st->rays_refine = st->rays_primary - centres; /* a ray kind of its own in --stats */
+        st->rays_primary = centres;
+    }
+    st->render_ms = clu_now_ms() - t_start;
+    return rc;
 }
 
 void renderer_release(Renderer *r)
 {
     cl_mem *mems[] = {&r->tris,    &r->normals, &r->cell_start, &r->cell_tris, &r->materials,
                       &r->objects, &r->lights,  &r->patterns,   &r->texels,    &r->frame,
-                      &r->rays,    &r->hits,    &r->media,      &r->radiance,  &r->counters};
+                      &r->rays,    &r->hits,    &r->media,      &r->radiance,  &r->counters,
+                      &r->aa_pass, &r->film,    &r->levels,     &r->marks,     &r->mark_counts};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) {
             CL_WARN(clReleaseMemObject(*mems[i]));
             *mems[i] = NULL;
         }
-    cl_kernel *ks[] = {&r->k_camera, &r->k_intersect, &r->k_shading, &r->k_tree};
-    for (size_t i = 0; i < 4; i++)
+    cl_kernel *ks[] = {&r->k_camera,      &r->k_intersect,   &r->k_shading,       &r->k_tree,
+                       &r->k_aa_generate, &r->k_aa_contrast, &r->k_aa_reconstruct};
+    for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++)
         if (*ks[i]) {
             CL_WARN(clReleaseKernel(*ks[i]));
             *ks[i] = NULL;
         }
     if (r->program) CL_WARN(clReleaseProgram(r->program));
     r->program = NULL;
+    free(r->aa_levels);
+    r->aa_levels = NULL;
     grid_free(&r->grid);
 }

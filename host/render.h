@@ -10,6 +10,7 @@
 /* What a render did and how long each part took (--stats). */
 typedef struct RenderStats {
     unsigned long long rays_primary, rays_shadow, shadow_skipped;
+    unsigned long long rays_refine; /* adaptive anti-aliasing samples beyond pass 0 */
     unsigned long long traversal_steps, tri_tests;
     unsigned long long reflected, transmitted, pruned, depth_cut, tir, pass_through;
     unsigned long long interfaces, energy_errors;
@@ -22,6 +23,12 @@ typedef struct RenderStats {
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
     double render_ms; /* wall time of the tile loop */
     int tiles, tile_pixels;
+    /* anti-aliasing (--aa: adaptive, --ssaa: uniform; host/aa.c) */
+    int aa_rounds;                                          /* contrast passes that marked pixels */
+    unsigned long long aa_refined[VBCL_AA_MAX_LEVEL + 1];   /* [L]: pixels refined to level L */
+    unsigned long long samples;                             /* camera rays through the film */
+    unsigned samples_max;                                   /* most samples of one pixel */
+    double aa_contrast_ms, aa_refine_ms, aa_reconstruct_ms; /* event profiling */
 } RenderStats;
 
 /* A scene on a device, ready to render. */
@@ -32,9 +39,17 @@ typedef struct Renderer {
     cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels;
     cl_mem frame;
     cl_mem rays, hits, media, radiance, counters;
+    /* anti-aliasing, created on first use (host/aa.c) */
+    cl_kernel k_aa_generate, k_aa_contrast, k_aa_reconstruct;
+    cl_mem aa_pass, film, levels, marks, mark_counts;
+    int *aa_levels; /* after an adaptive render: each pixel's refinement level, else NULL */
     Grid grid;
     VbFrame frame_host;
     int tile_pixels;
+    int ray_capacity;  /* rays the ray buffers hold: the tile, and at least one 16x16 pixel */
+    size_t local_size; /* work-group size of the tracing and anti-aliasing kernels, or 0 for
+                        * the driver's choice: fixed, so that PoCL compiles one work-group
+                        * function per kernel however the batch sizes vary */
     unsigned features;
 } Renderer;
 
@@ -44,9 +59,11 @@ typedef struct Renderer {
 int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
                   RenderStats *st, char *err, size_t errlen);
 
-/* Renders the whole image into rgba (width*height*4 floats, linear, row 0 at the top).
- * With progress set, reports progress on stderr once the render has taken a second.
- * Returns 0, or 1 with a message in err. */
+/* Renders the whole image into rgba (width*height*4 floats, linear, row 0 at the top):
+ * one ray through each pixel centre, then with s->aa_threshold > 0 adaptive refinement
+ * (r->aa_levels holds the levels reached); with s->ssaa > 1 instead N x N samples in
+ * every pixel. With progress set, reports progress on stderr once the render has taken a
+ * second. Returns 0, or 1 with a message in err. */
 int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
                     char *err, size_t errlen);
 
@@ -59,6 +76,18 @@ int renderer_set_scene_args(const Renderer *r, cl_kernel k);
  * radiance, counters. */
 int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nrays, cl_mem hits,
                             cl_mem media, cl_mem radiance, cl_mem counters);
+
+/* Traces the n camera rays in r->rays (first interfaces, local shading, ray trees) into
+ * r->radiance, adds their counts and kernel times to st and the tracing kernels' time to
+ * *trace_ms (may be NULL), and waits for them. n <= r->ray_capacity. Returns 0, or -1
+ * with the error recorded (clu_error). */
+int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms);
+
+/* Lowers r->local_size to 0 unless kernel k runs work-groups of that size. Returns 0. */
+int renderer_fit_local_size(Renderer *r, cl_kernel k);
+
+/* The local size argument of clEnqueueNDRangeKernel for the global size `global`. */
+const size_t *renderer_local(const Renderer *r, size_t global);
 
 /* Releases everything renderer_init created. */
 void renderer_release(Renderer *r);

@@ -322,9 +322,9 @@ static int load_camera(Ctx *c, const cJSON *j, Scene *s)
 
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {"max_depth",      "grid",       "grid_density",
-                                       "shadow_samples", "ambient",    "seed",
-                                       "fresnel",        "min_weight", NULL};
+    static const char *const keys[] = {
+        "max_depth", "grid",       "grid_density", "shadow_samples", "ambient", "seed",
+        "fresnel",   "min_weight", "aa",           "aa_max_level",   NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = GRID_DEFAULT_DENSITY;
@@ -333,6 +333,9 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->seed = 1;
     s->fresnel = SCENE_FRESNEL_EXACT;
     s->min_weight = 1e-3f;
+    s->aa_threshold = 0.0f;
+    s->aa_max_level = VBCL_AA_MAX_LEVEL;
+    s->ssaa = 1;
     if (!j) return 0; /* absent: all defaults */
     if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -342,7 +345,10 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
         get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
         get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
-        get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight))
+        get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight) ||
+        get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
+        get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
+                &s->aa_max_level))
         return -1;
     s->seed = (unsigned)seed;
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");

@@ -62,8 +62,11 @@ typedef struct Scene {
     int shadow_samples; /* as given; the kernels use the nearest square */
     float ambient[3];
     unsigned seed;
-    int fresnel;      /* SCENE_FRESNEL_* */
-    float min_weight; /* ray-tree pruning threshold */
+    int fresnel;        /* SCENE_FRESNEL_* */
+    float min_weight;   /* ray-tree pruning threshold */
+    float aa_threshold; /* adaptive anti-aliasing contrast threshold; 0: off */
+    int aa_max_level;   /* deepest refinement level: 2^level x 2^level samples (1..4) */
+    int ssaa;           /* uniform N x N supersampling (command line only); 1: off */
     /* contents */
     int nlights;
     VbLight *lights;

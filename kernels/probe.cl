@@ -40,6 +40,8 @@ __kernel void probe_layout(__global uint *out)
     out[7] = VBCL_OFFSETOF(VbFrame, seed);
     out[8] = VBCL_OFFSETOF(VbMaterial, eta);
     out[9] = VBCL_OFFSETOF(VbLight, radiance);
+    out[10] = sizeof(VbAaPass);
+    out[11] = VBCL_OFFSETOF(VbAaPass, seg_offset);
 }
 
 /* The scene arguments every frame kernel starts with, for probes that shade. */

@@ -1,12 +1,16 @@
 #line 2 "render.cl"
 /* render.cl — the kernel entry points of a frame, run tile by tile:
  *   camera_generate_rays    frame              -> rays
+ *   aa_generate_rays        frame, marks       -> rays (supersamples of listed pixels)
  *   scene_intersect_closest rays               -> hits, media (first interface of each ray)
  *   light_sample_shading    rays, hits, media  -> radiance (k_local term, shadow feelers)
  *   tree_trace_secondary    rays, hits, media  -> radiance += (k_global term: the ray tree;
  *                                                 only with VBCL_HAS_TRANSPARENCY)
- * Every entry point takes the same arguments (FRAME_KERNEL_ARGS), is thin — index,
- * bounds guard, device functions — and the host concatenates these files in order. */
+ *   aa_contrast_mark        film, levels       -> marks (pixels to refine; whole image)
+ *   aa_reconstruct          radiance, marks    -> film, levels (box window per pixel)
+ * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
+ * adds the pass and the list, the other aa_* kernels take only their own buffers), are
+ * thin — index, bounds guard, device functions — and the host concatenates these files. */
 
 #include "types.h"
 #include "geometry.cl"
@@ -16,6 +20,7 @@
 #include "medium.cl"
 #include "light.cl"
 #include "tree.cl"
+#include "aa.cl"
 
 #if defined(VBCL_HAS_TRANSPARENCY) || defined(VBCL_HAS_TEXTURES)
 #define VBCL_HAS_MEDIA 1 /* rays track the medium they are in */
@@ -87,19 +92,21 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     return sp;
 }
 
-VB_INLINE uint pixel_key(__constant const VbFrame *f, int i)
+/* The jitter key of a film sample (VbRay.sample) under the frame's seed. */
+VB_INLINE uint sample_key(__constant const VbFrame *f, uint sample)
 {
-    return vb_hash((uint)(f->first_pixel + i) ^ vb_hash(f->seed));
+    return vb_hash(sample ^ vb_hash(f->seed));
 }
 
-/* frame -> rays: one ray through the centre of each pixel of the tile. */
+/* frame -> rays: one ray through the centre of each pixel of the tile; the sample id is
+ * the pixel index. */
 __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);
     if (i >= f->tile_pixels) return;
     int pixel = f->first_pixel + i;
     int x = pixel % f->width, y = pixel / f->width;
-    rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)i);
+    rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)pixel);
 }
 
 /* rays -> hits, media: the closest interface of each ray through the grid, and the
@@ -158,7 +165,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 #else
         uint material = scene_tri_material(&sc, h.tri);
 #endif
-        ShadePoint sp = shade_point_make(&sc, dir, h, pixel_key(f, i), before, material);
+        ShadePoint sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, material);
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0};
         col = weight * light_shade_local(&sc, &sp, &tc, &shc);
@@ -185,7 +192,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
     VbMedium before = media[i];
     Crossing c = medium_cross(&sc, h.tri, dir, before);
     if (materials[c.surface].k_global <= 0.0f) return;
-    uint key = pixel_key(f, i);
+    uint key = sample_key(f, r.sample);
     ShadePoint sp = shade_point_make(&sc, dir, h, key, before, c.surface);
     TreeRay stack[VB_TREE_STACK];
     int n = 0;
@@ -229,6 +236,59 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
     atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
 }
 #endif
+
+/* frame, marks -> rays: side x side rays through the subpixel centres of each pixel of a
+ * batch of listed pixels (complete stratification), ray i belonging to batch entry
+ * i / side^2 and subpixel i % side^2 (row-major). */
+__kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
+                               __global const uint *marks)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    uint n = (uint)(aa->side * aa->side);
+    uint e = aa->first + (uint)i / n, sub = (uint)i % n;
+    uint pixel = aa->identity ? e : marks[e];
+    int x = (int)(pixel % (uint)f->width), y = (int)(pixel / (uint)f->width);
+    float inv = 1.0f / (float)aa->side;
+    float px = (float)x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
+    float py = (float)y + ((float)(sub / (uint)aa->side) + 0.5f) * inv;
+    rays[i] = camera_ray(f, px, py, aa_sample_id(pixel, aa->side, sub));
+}
+
+/* film, levels -> marks, mark_counts: over the whole image, each pixel below the top
+ * level against its 8 neighbours; a marked pixel at level l is appended to the list
+ * segment of level l (mark_counts[l] counts it). */
+__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
+                               __global const int *levels, __global uint *marks,
+                               __global uint *mark_counts)
+{
+    int p = get_global_id(0);
+    if (p >= aa->width * aa->height) return;
+    int lv = levels[p];
+    if (lv >= aa->max_level) return;
+    if (aa_pixel_marked(aa, film, levels, p, lv)) {
+        uint k = atomic_inc(&mark_counts[lv]);
+        marks[aa->seg_offset[lv] + k] = (uint)p;
+    }
+}
+
+/* radiance, marks -> film (and levels): each pixel of a batch becomes the mean of its
+ * side^2 samples — a box window over its own subpixels (thesis figure 4.4), so refining
+ * a pixel changes no other pixel. */
+__kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const uint *marks,
+                             __global const float *radiance, __global float *film,
+                             __global int *levels)
+{
+    uint j = get_global_id(0);
+    if (j >= aa->entries) return;
+    uint n = (uint)(aa->side * aa->side);
+    uint e = aa->first + j;
+    uint pixel = aa->identity ? e : marks[e];
+    float4 sum = (float4)(0.0f);
+    for (uint k = 0; k < n; k++) sum += vload4(j * n + k, radiance);
+    vstore4(sum * (1.0f / (float)n), pixel, film);
+    if (aa->write_level) levels[pixel] = aa->level;
+}
 
 #ifdef VBCL_TEST_KERNELS
 #include "probe.cl"

@@ -57,7 +57,9 @@ typedef struct VbRay {
     float org[3];
     float tmax;          /* farthest accepted hit distance (in units of |dir|) */
     float dir[3];        /* unit length */
-    unsigned int sample; /* film sample this ray belongs to (index within the tile) */
+    unsigned int sample; /* the film sample's id, the key of its shading jitter: the pixel
+                          * index for a ray through a pixel's centre, a hash of (pixel,
+                          * samples per axis, subpixel) for a supersample (aa_sample_id) */
 } VbRay;
 
 /* The closest hit of a ray. */
@@ -150,6 +152,29 @@ typedef struct VbGrid {
     int n[4];          /* cells per axis (w unused) */
 } VbGrid;
 
+/* Anti-aliasing (thesis 4.1.2): a pixel at refinement level L is the box-filtered mean of
+ * 2^L x 2^L samples at its subpixel centres; level 0 is the single ray through its centre. */
+#define VBCL_AA_MAX_LEVEL 4 /* 16x16 subpixels, the thesis's bound */
+
+/* One step of the anti-aliasing passes (aa_* kernels in render.cl), uploaded before each
+ * launch: the contrast test's parameters, or a batch of pixels to supersample. */
+typedef struct VbAaPass {
+    float threshold;          /* a pair of neighbours fails when |a-b| / (a+b) > threshold */
+    float contrast_scale;     /* values are scaled by 2^exposure and clamped to [0, 1] first */
+    int max_level;            /* pixels at this level are never marked */
+    int width, height;        /* image size in pixels */
+    int side;                 /* batch: samples per pixel axis (2^level, or N of --ssaa) */
+    int level;                /* batch: the level its pixels reach (written to the level map) */
+    unsigned int identity;    /* batch: 1 if list entry e is pixel e (uniform supersampling) */
+    unsigned int first;       /* batch: its first entry in the list of marked pixels */
+    unsigned int entries;     /* batch: pixels in it */
+    unsigned int write_level; /* batch: 1 to record the level (adaptive), 0 (uniform) */
+    unsigned int pad;
+    unsigned int seg_offset[VBCL_AA_MAX_LEVEL]; /* contrast: where the list of marked pixels
+                                                 * at level l starts (capacity: the number
+                                                 * of pixels at level l) */
+} VbAaPass;
+
 /* Everything a frame's kernels read besides the big buffers. */
 typedef struct VbFrame {
     VbCamera camera;
@@ -197,5 +222,9 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, grid) == 64, frame_grid);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, background) == 144, frame_background);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, width) == 176, frame_width);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, seed) == 204, frame_seed);
+VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 64, aapass_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 32, aapass_first);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, seg_offset) == 48, aapass_seg_offset);
 
 #endif

@@ -26,13 +26,13 @@ static void test_kernel_struct_layout(void)
             "{\"camera\": {\"eye\": [0,0,5], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
             " \"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
         return;
-    cl_uint out[10] = {0};
+    cl_uint out[12] = {0};
     cl_mem m = buffer(NULL, sizeof out);
     const size_t sz[] = {sizeof(cl_mem)};
     const void *v[] = {&m};
     run_kernel(fx.r.program, "probe_layout", 1, 1, sz, v);
     read_buffer(m, out, sizeof out);
-    const cl_uint want[10] = {sizeof(VbRay),
+    const cl_uint want[12] = {sizeof(VbRay),
                               sizeof(VbHit),
                               sizeof(VbTriangle),
                               sizeof(VbMaterial),
@@ -41,8 +41,10 @@ static void test_kernel_struct_layout(void)
                               offsetof(VbFrame, background),
                               offsetof(VbFrame, seed),
                               offsetof(VbMaterial, eta),
-                              offsetof(VbLight, radiance)};
-    for (int i = 0; i < 10; i++)
+                              offsetof(VbLight, radiance),
+                              sizeof(VbAaPass),
+                              offsetof(VbAaPass, seg_offset)};
+    for (int i = 0; i < 12; i++)
         CHECK(out[i] == want[i], "layout item %d: device %u, host %u", i, out[i], want[i]);
     clReleaseMemObject(m);
     fixture_close(&fx);

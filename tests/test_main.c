@@ -107,5 +107,6 @@ int main(int argc, char **argv)
     suite_patterns();
     suite_stability();
     suite_render();
+    suite_aa();
     return th_summary();
 }

@@ -34,5 +34,6 @@ void suite_optics(void);
 void suite_patterns(void);
 void suite_stability(void);
 void suite_render(void);
+void suite_aa(void);
 
 #endif

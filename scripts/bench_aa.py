@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+"""bench_aa.py — anti-aliasing: run time against error, adaptive (--aa THRESHOLD) and
+uniform (--ssaa N) supersampling, each against a converged --ssaa 16 reference of the
+same scene (docs/architecture.md, "Measurements").
+
+usage: scripts/bench_aa.py [--quick] [--vbcl ./vbcl] [--out bench-out] [--repeats N]
+
+Writes OUT/aa_time_error.csv (one row per render) and OUT/aa_time_error.png (RMSE against
+render time, one panel per scene). Time is the render's wall time from --stats (pass 0,
+refinement and read-back; not the program build). Error: RMSE over the RGB channels of the
+linear image clamped to [0, 1] (what a display shows), and PSNR = 20 log10(1 / RMSE).
+The reference is rendered with another render.seed, so that its shadow-feeler jitter is
+independent of the images measured (the adaptive mode's level-4 pixels would otherwise
+equal it exactly); its subpixel positions are the same 16x16 grid.
+--quick renders tiny images (for CI: well under a minute).
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+
+def need_modules():
+    try:
+        import numpy  # noqa: F401
+        import matplotlib  # noqa: F401
+    except ImportError:
+        print("bench_aa: installing numpy and matplotlib (pip --user)", file=sys.stderr)
+        subprocess.check_call([sys.executable, "-m", "pip", "install", "--user", "--quiet",
+                               "numpy", "matplotlib"])
+        import site
+        import importlib
+        importlib.invalidate_caches()
+        site.addsitedir(site.getusersitepackages())
+
+
+need_modules()
+import numpy as np  # noqa: E402
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+# scene, label, size, extra options
+FULL = [
+    ("tests/scenes/aa_edges.json", "aa_edges (flat colours, hard edges)", 128, []),
+    ("scenes/quickstart.json", "quickstart (soft shadows)", 128, []),
+    ("scenes/glass_bombed_sphere.json", "glass_bombed_sphere (ray trees)", 64,
+     ["--shadow-samples", "4"]),
+]
+QUICK = [
+    ("tests/scenes/aa_edges.json", "aa_edges", 32, []),
+    ("scenes/quickstart.json", "quickstart", 32, ["--shadow-samples", "4"]),
+]
+THRESHOLDS_FULL = [1.0, 0.6, 0.4, 0.2, 0.1, 0.05, 0.02]
+THRESHOLDS_QUICK = [1.0, 0.4, 0.1, 0.02]
+UNIFORM_FULL = [1, 2, 4, 8]
+UNIFORM_QUICK = [1, 2, 4]
+
+
+def read_exr(path):
+    """Pixels of an EXR as a float array (h, w, 3), through oiiotool's C dump."""
+    text = subprocess.run(["oiiotool", "--dumpdata:C=img", path], check=True,
+                          capture_output=True, text=True).stdout
+    m = re.search(r"img\[(\d+)\]\[(\d+)\]\[(\d+)\]", text)
+    h, w, c = (int(g) for g in m.groups())
+    body = re.sub(r"/\*.*?\*/", " ", text[text.index("=", m.end()):], flags=re.S)
+    vals = np.array(re.findall(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|nan|inf", body),
+                    dtype=np.float64)
+    return vals[: h * w * c].reshape(h, w, c)[:, :, :3]
+
+
+def reseeded(scene):
+    """A copy of scene beside it (relative mesh paths still resolve) with another seed."""
+    with open(scene) as f:
+        data = json.load(f)
+    data.setdefault("render", {})["seed"] = 7919
+    path = os.path.join(os.path.dirname(scene) or ".", f".bench_aa_ref_{os.getpid()}.json")
+    with open(path, "w") as f:
+        json.dump(data, f)
+    return path
+
+
+def render(vbcl, scene, size, extra, opts, out):
+    cmd = [vbcl, scene, "-q", "--stats", "--width", str(size), "--height", str(size), "-o", out]
+    cmd += extra + opts
+    log = subprocess.run(cmd, check=True, capture_output=True, text=True).stderr
+    ms = float(re.search(r"\| render ([\d.]+) ms", log).group(1))
+    spp = float(re.search(r"^samples\s+([\d.]+) per pixel", log, re.M).group(1))
+    return ms, spp
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="tiny images, fewer settings (CI)")
+    ap.add_argument("--vbcl", default="./vbcl")
+    ap.add_argument("--out", default="bench-out")
+    ap.add_argument("--repeats", type=int, default=None,
+                    help="renders per setting, median time (default 3; --quick 1)")
+    a = ap.parse_args()
+    scenes = QUICK if a.quick else FULL
+    thresholds = THRESHOLDS_QUICK if a.quick else THRESHOLDS_FULL
+    uniform = UNIFORM_QUICK if a.quick else UNIFORM_FULL
+    repeats = a.repeats or (1 if a.quick else 3)
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for scene, label, size, extra in scenes:
+            name = os.path.splitext(os.path.basename(scene))[0]
+            ref_path = os.path.join(tmp, name + "_ref.exr")
+            # warm the program cache, then the reference
+            render(a.vbcl, scene, size, extra, [], os.path.join(tmp, "warm.exr"))
+            ref_scene = reseeded(scene)
+            try:
+                ref_ms, _ = render(a.vbcl, ref_scene, size, extra, ["--ssaa", "16"], ref_path)
+            finally:
+                os.remove(ref_scene)
+            ref = np.clip(read_exr(ref_path), 0.0, 1.0)
+            settings = [("adaptive", t, ["--aa", str(t)]) for t in thresholds]
+            settings += [("uniform", n, ["--ssaa", str(n)]) for n in uniform]
+            for method, param, opts in settings:
+                out = os.path.join(tmp, "img.exr")
+                times = []
+                for _ in range(repeats):
+                    ms, spp = render(a.vbcl, scene, size, extra, opts, out)
+                    times.append(ms)
+                img = np.clip(read_exr(out), 0.0, 1.0)
+                rmse = float(np.sqrt(np.mean((img - ref) ** 2)))
+                psnr = 20.0 * np.log10(1.0 / rmse) if rmse > 0 else float("inf")
+                row = {"scene": name, "size": f"{size}x{size}", "method": method,
+                       "param": param, "render_ms": round(float(np.median(times)), 1),
+                       "samples_per_pixel": spp, "rmse": f"{rmse:.6g}",
+                       "psnr_db": f"{psnr:.2f}", "reference_ms": round(ref_ms, 1),
+                       "label": label}
+                rows.append(row)
+                print(f"{name:22s} {method:8s} {param!s:5s} {row['render_ms']:9.1f} ms "
+                      f"{spp:7.2f} spp  RMSE {rmse:.5f}  PSNR {psnr:6.2f} dB", flush=True)
+    csv_path = os.path.join(a.out, "aa_time_error.csv")
+    with open(csv_path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k != "label"],
+                           extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    plot(rows, scenes, os.path.join(a.out, "aa_time_error.png"))
+    print(f"bench_aa: wrote {csv_path} and {os.path.join(a.out, 'aa_time_error.png')}")
+
+
+def plot(rows, scenes, path):
+    fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), squeeze=False)
+    for ax, (scene, label, size, _) in zip(axes[0], scenes):
+        name = os.path.splitext(os.path.basename(scene))[0]
+        for method, style, fmt in (("adaptive", "o-", "{:g}"), ("uniform", "s--", "{}x{}")):
+            rs = [r for r in rows if r["scene"] == name and r["method"] == method]
+            xs = [r["render_ms"] / 1000.0 for r in rs]
+            ys = [max(float(r["rmse"]), 1e-7) for r in rs]
+            ax.plot(xs, ys, style, label=f"{method} ({'threshold' if method == 'adaptive' else 'N x N'})")
+            for r, x, y in zip(rs, xs, ys):
+                txt = fmt.format(r["param"], r["param"]) if method == "uniform" else fmt.format(r["param"])
+                ax.annotate(txt, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ref_ms = next(r["reference_ms"] for r in rows if r["scene"] == name)
+        ax.set_title(f"{label}, {size}x{size}\nreference 16x16: {ref_ms / 1000:.1f} s", fontsize=9)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("render time (s)")
+        ax.set_ylabel("RMSE vs 16x16")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+if __name__ == "__main__":
+    main()
