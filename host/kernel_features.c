@@ -19,6 +19,7 @@ static const struct {
     {VBCL_FEATURE_ABSORPTION, "absorption", "VBCL_HAS_ABSORPTION"},
     {VBCL_FEATURE_FRESNEL_THESIS, "fresnel-thesis", "VBCL_HAS_FRESNEL_THESIS"},
     {VBCL_FEATURE_PATTERNS, "patterns", "VBCL_HAS_PATTERNS"},
+    {VBCL_FEATURE_DISPERSION, "dispersion", "VBCL_HAS_DISPERSION"},
 };
 
 /* What material m needs from the kernels when an object uses it. */
@@ -32,6 +33,7 @@ static unsigned material_features(const VbMaterial *m)
         f |= VBCL_FEATURE_TRANSPARENCY;
         if (m->extinction[0] > 0.0f || m->extinction[1] > 0.0f || m->extinction[2] > 0.0f)
             f |= VBCL_FEATURE_ABSORPTION;
+        if (m->disp >= 0) f |= VBCL_FEATURE_DISPERSION;
     }
     return f;
 }
@@ -57,7 +59,10 @@ void features_build_options(unsigned features, const Scene *s, const char *extra
                             size_t n)
 {
     int stack = 8;
-    while (stack < s->max_depth + 1) stack *= 2; /* size classes 8, 16, 32, 64, 128 */
+    /* depth first: one pending sibling per level, plus the bands of the one split on the
+     * path (a band ray never splits again) */
+    int need = s->max_depth + 1 + ((features & VBCL_FEATURE_DISPERSION) ? s->bands : 0);
+    while (stack < need) stack *= 2; /* size classes 8, 16, 32, 64, 128 */
     size_t len = (size_t)snprintf(out, n, "-cl-std=CL1.2");
     if (features & VBCL_FEATURE_TRANSPARENCY)
         len += (size_t)snprintf(out + len, n - len, " -DVBCL_TREE_STACK=%d", stack);

@@ -40,6 +40,7 @@ static const char usage_text[] =
     "      --aa THRESHOLD       adaptive anti-aliasing: refine pixels whose contrast\n"
     "                           |a-b|/(a+b) with a neighbour exceeds THRESHOLD (0..1; 0 off)\n"
     "      --aa-max-level L     deepest refinement, 2^L x 2^L samples per pixel (1..4)\n"
+    "      --bands N            wavelength bands of a dispersive refraction (1..64)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
@@ -58,7 +59,7 @@ static const char usage_text[] =
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map;
-    int width, height, shadow_samples, depth, aa_max_level, ssaa;
+    int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
     double grid_density, exposure, min_weight, aa;
     int have_exposure;
     int list_devices, stats, quiet;
@@ -109,7 +110,7 @@ static int parse_args(int argc, char **argv, Options *o)
     memset(o, 0, sizeof *o);
     o->width = o->height = o->shadow_samples = o->depth = -1;
     o->grid_density = o->min_weight = o->aa = -1;
-    o->aa_max_level = o->ssaa = -1;
+    o->aa_max_level = o->ssaa = o->bands = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -163,6 +164,9 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "--aa-max-level")) {
             NEEDS_VALUE;
             if (parse_int(a, val, 1, VBCL_AA_MAX_LEVEL, &o->aa_max_level)) return 2;
+        } else if (!strcmp(a, "--bands")) {
+            NEEDS_VALUE;
+            if (parse_int(a, val, 1, DISP_MAX_BANDS, &o->bands)) return 2;
         } else if (!strcmp(a, "--ssaa")) {
             NEEDS_VALUE;
             if (parse_int(a, val, 1, 16, &o->ssaa)) return 2;
@@ -245,6 +249,9 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
             st->depth_cut, s->max_depth);
         fprintf(stderr, "energy      %llu interfaces split, %llu with |R + T - 1| > 1e-5\n",
                 st->interfaces, st->energy_errors);
+        if (st->features & VBCL_FEATURE_DISPERSION)
+            fprintf(stderr, "dispersion  %llu rays split into %d bands, %llu band rays traced\n",
+                    st->splits, s->bands, st->band_rays);
         fprintf(stderr, "by depth   ");
         for (int k = 0; k < VBCL_COUNT_DEPTH_BINS; k++)
             if (st->by_depth[k])
@@ -332,6 +339,7 @@ int main(int argc, char **argv)
     if (o.min_weight >= 0) s.min_weight = (float)o.min_weight;
     if (o.aa >= 0) s.aa_threshold = (float)o.aa;
     if (o.aa_max_level > 0) s.aa_max_level = o.aa_max_level;
+    if (o.bands > 0) s.bands = o.bands;
     if (o.ssaa > 0) s.ssaa = o.ssaa;
     if (s.ssaa > 1 && s.aa_threshold > 0.0f) {
         if (o.aa > 0) {

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "aa.h"
+#include "dispersion.h"
 #include "kernel_features.h"
 #include "texgen.h"
 
@@ -151,6 +152,45 @@ static int upload_patterns(Renderer *r, const Scene *s, VbMaterial *mats, char *
         }
         mats[i].pattern = npats++;
     }
+    if (!rc && (r->features & VBCL_FEATURE_DISPERSION)) {
+        /* the side data after the images: the bands' rgb weights, then per dispersive
+         * material its band table (eta, transmitted fraction) at each band's centre */
+        int nb = s->bands, ndisp = 0;
+        for (int i = 0; i < s->nmaterials; i++) ndisp += mats[i].disp >= 0;
+        float *grown =
+            realloc(texels, sizeof(float) * 4 * (ntexels + (size_t)nb * (size_t)(1 + ndisp)));
+        if (!grown) {
+            rc = 1;
+            snprintf(err, errlen, "out of memory for the band tables");
+        } else {
+            texels = grown;
+            float w[DISP_MAX_BANDS][3];
+            disp_band_weights(nb, w);
+            r->band_weights = (unsigned)(4 * ntexels);
+            for (int b = 0; b < nb; b++, ntexels++) {
+                float *t = texels + 4 * ntexels;
+                t[0] = w[b][0];
+                t[1] = w[b][1];
+                t[2] = w[b][2];
+                t[3] = (float)disp_band_centre(nb, b);
+            }
+            for (int i = 0; i < s->nmaterials; i++) {
+                if (mats[i].disp < 0) continue;
+                const DispModel *d = &s->materials[i].disp;
+                mats[i].disp = (int)(4 * ntexels);
+                for (int b = 0; b < nb; b++, ntexels++) {
+                    double lo, hi;
+                    disp_band_edges(nb, b, &lo, &hi);
+                    float *t = texels + 4 * ntexels;
+                    t[0] = (float)disp_eta(d, 0.5 * (lo + hi));
+                    t[1] = (float)disp_band_transmit(d, lo, hi);
+                    t[2] = t[3] = 0.0f;
+                }
+            }
+        }
+    } else {
+        for (int i = 0; i < s->nmaterials; i++) mats[i].disp = -1;
+    }
     if (!rc) {
         r->patterns = upload(r->dev, pats, sizeof *pats * (size_t)npats, CL_MEM_READ_ONLY);
         r->texels = upload(r->dev, texels, sizeof(float) * 4 * ntexels, CL_MEM_READ_ONLY);
@@ -292,6 +332,7 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
     mats[s->nmaterials].eta = 1.0f;
     mats[s->nmaterials].pattern = -1;
+    mats[s->nmaterials].disp = -1;
     int prc = upload_patterns(r, s, mats, err, errlen);
     if (prc) {
         free(mats);
@@ -334,6 +375,8 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     f->air_material = (unsigned)s->nmaterials;
     f->min_weight = s->min_weight;
     f->max_depth = s->max_depth;
+    f->bands = s->bands;
+    f->band_weights = r->band_weights;
     r->frame = upload(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
 
     /* tiles: bounded so that 32-bit work counters of one tile cannot overflow */
@@ -410,6 +453,8 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
     st->pruned += counts[VBCL_COUNT_PRUNED];
     st->depth_cut += counts[VBCL_COUNT_DEPTH_CUT];
     st->tir += counts[VBCL_COUNT_TIR];
+    st->splits += counts[VBCL_COUNT_SPLITS];
+    st->band_rays += counts[VBCL_COUNT_BAND_RAYS];
     st->pass_through += counts[VBCL_COUNT_PASS_THROUGH];
     st->interfaces += counts[VBCL_COUNT_INTERFACES];
     st->energy_errors += counts[VBCL_COUNT_ENERGY_ERRORS];

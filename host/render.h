@@ -14,6 +14,7 @@ typedef struct RenderStats {
     unsigned long long traversal_steps, tri_tests;
     unsigned long long reflected, transmitted, pruned, depth_cut, tir, pass_through;
     unsigned long long interfaces, energy_errors;
+    unsigned long long splits, band_rays; /* dispersion: white rays split, band rays traced */
     unsigned long long by_depth[VBCL_COUNT_DEPTH_BINS]; /* [0]: primary rays */
     unsigned features;
     char options[512];
@@ -51,6 +52,7 @@ typedef struct Renderer {
                         * the driver's choice: fixed, so that PoCL compiles one work-group
                         * function per kernel however the batch sizes vary */
     unsigned features;
+    unsigned band_weights; /* dispersion: first float of the band weights in texels */
 } Renderer;
 
 /* Prepares s for rendering on dev: grid, program (extra build options appended, may be

@@ -324,7 +324,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {
         "max_depth", "grid",       "grid_density", "shadow_samples", "ambient", "seed",
-        "fresnel",   "min_weight", "aa",           "aa_max_level",   NULL};
+        "fresnel",   "min_weight", "aa",           "aa_max_level",   "bands",   NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = GRID_DEFAULT_DENSITY;
@@ -336,6 +336,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->aa_threshold = 0.0f;
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
     s->ssaa = 1;
+    s->bands = 8;
     if (!j) return 0; /* absent: all defaults */
     if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -348,7 +349,8 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight) ||
         get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
         get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
-                &s->aa_max_level))
+                &s->aa_max_level) ||
+        get_int(c, j, "render", "bands", 1, DISP_MAX_BANDS, 8, 0, &s->bands))
         return -1;
     s->seed = (unsigned)seed;
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
@@ -489,10 +491,65 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
     return 0;
 }
 
+/* materials.NAME.dispersion: {"model": "cauchy", "abbe": V_d} (n_d = the material's eta),
+ * {"model": "sellmeier", "preset": "BK7" | "F2"} or {"model": "sellmeier", "B": [3], "C": [3]},
+ * each with an optional absorption band "band": [lo, hi] (nm) and "jump" (Δη beyond it). */
+static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta, DispModel *d)
+{
+    static const char *const keys[] = {"model", "abbe", "preset", "B", "C", "band", "jump", NULL};
+    memset(d, 0, sizeof *d);
+    const cJSON *j = cJSON_GetObjectItemCaseSensitive(mat, "dispersion");
+    if (!j) return 0;
+    char p[PATH_MAX_LEN], q[PATH_MAX_LEN];
+    path_key(p, path, "dispersion");
+    if (expect_object(c, j, p) || check_keys(c, j, p, keys)) return -1;
+    const cJSON *model = cJSON_GetObjectItemCaseSensitive(j, "model");
+    path_key(q, p, "model");
+    if (!cJSON_IsString(model)) return fail(c, q, "expected \"cauchy\" or \"sellmeier\"");
+    if (strcmp(model->valuestring, "cauchy") == 0) {
+        double abbe;
+        if (get_num(c, j, p, "abbe", 1, 200, 0, 1, &abbe)) return -1;
+        disp_cauchy_from_abbe(d, eta, abbe);
+    } else if (strcmp(model->valuestring, "sellmeier") == 0) {
+        const cJSON *pre = cJSON_GetObjectItemCaseSensitive(j, "preset");
+        path_key(q, p, "preset");
+        if (pre) {
+            if (!cJSON_IsString(pre) || disp_sellmeier_preset(d, pre->valuestring))
+                return fail(c, q, "expected \"BK7\" or \"F2\"");
+        } else {
+            float b[3], cc[3];
+            if (get_vec(c, j, p, "B", 3, 0, 100, NULL, b) ||
+                get_vec(c, j, p, "C", 3, 0, 1e4, NULL, cc))
+                return -1;
+            d->model = DISP_SELLMEIER;
+            for (int i = 0; i < 3; i++) {
+                d->sb[i] = b[i];
+                d->sc[i] = cc[i];
+            }
+        }
+    } else {
+        return fail(c, q, "expected \"cauchy\" or \"sellmeier\", got \"%s\"", model->valuestring);
+    }
+    if (cJSON_GetObjectItemCaseSensitive(j, "band")) {
+        float band[2], jump;
+        if (get_vec(c, j, p, "band", 2, DISP_LAMBDA_MIN, DISP_LAMBDA_MAX, NULL, band) ||
+            get_float(c, j, p, "jump", -10, 10, 0, 0, &jump))
+            return -1;
+        path_key(q, p, "band");
+        if (!(band[1] > band[0])) return fail(c, q, "expected [lo, hi] with lo < hi");
+        d->has_band = 1;
+        d->band_lo = band[0];
+        d->band_hi = band[1];
+        d->jump = jump;
+    }
+    return 0;
+}
+
 static int load_materials(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {"ambient",  "diffuse", "specular",   "exponent", "k_local",
-                                       "k_global", "eta",     "extinction", "pattern",  NULL};
+    static const char *const keys[] = {"ambient", "diffuse",    "specular", "exponent",
+                                       "k_local", "k_global",   "eta",      "extinction",
+                                       "pattern", "dispersion", NULL};
     static const float grey[3] = {0.8f, 0.8f, 0.8f}, black[3] = {0, 0, 0};
     if (!j) return fail(c, "materials", "missing (expected an object of named materials)");
     if (expect_object(c, j, "materials")) return -1;
@@ -524,9 +581,10 @@ static int load_materials(Ctx *c, const cJSON *j, Scene *s)
         s->nmaterials = i + 1; /* from here on scene_free releases its pattern */
         g->pattern = -1;
         if (get_scalar_or_vec3(c, e, p, "extinction", 0, FLT_MAX, 0, g->extinction) ||
-            load_pattern(c, e, p, s, &m->pattern))
+            load_pattern(c, e, p, s, &m->pattern) || load_dispersion(c, e, p, g->eta, &m->disp))
             return -1;
-        if (m->pattern.kind) g->pattern = 0; /* has one; the renderer assigns the index */
+        if (m->pattern.kind) g->pattern = 0;           /* has one; the renderer assigns the index */
+        g->disp = m->disp.model != DISP_NONE ? 0 : -1; /* likewise its band table's offset */
     }
     s->nmaterials = n;
     return 0;

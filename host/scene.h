@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dispersion.h"
 #include "mesh.h"
 #include "types.h"
 
@@ -29,6 +30,7 @@ typedef struct SceneMaterial {
     char name[SCENE_NAME_MAX];
     VbMaterial gpu;
     ScenePattern pattern;
+    DispModel disp; /* materials.NAME.dispersion; model DISP_NONE: constant eta */
 } SceneMaterial;
 
 typedef struct SceneObject {
@@ -67,6 +69,7 @@ typedef struct Scene {
     float aa_threshold; /* adaptive anti-aliasing contrast threshold; 0: off */
     int aa_max_level;   /* deepest refinement level: 2^level x 2^level samples (1..4) */
     int ssaa;           /* uniform N x N supersampling (command line only); 1: off */
+    int bands;          /* render.bands: wavelength bands of a dispersive split */
     /* contents */
     int nlights;
     VbLight *lights;

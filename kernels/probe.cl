@@ -117,3 +117,45 @@ __kernel void probe_pattern(PROBE_SCENE_ARGS, int material, __global const float
     float3 c = scene_pattern_colour(&sc, materials + material, vload3(0, points + 4 * i));
     vstore4((float4)(c, 0.0f), i, out);
 }
+
+#ifdef VBCL_HAS_TRANSPARENCY
+/* ray (org xyz, dir xyz) -> the rays of its tree that leave the scene, 8 floats each:
+ * (dir xyz, band; weight rgb, depth), at most cap of them; *count gets how many left.
+ * The same tree as tree_trace_secondary, from a ray of the test's choosing. */
+__kernel void probe_tree_exits(PROBE_SCENE_ARGS, __global const float *ray, int cap,
+                               __global float *out, __global int *count)
+{
+    if (get_global_id(0) != 0) return;
+    DevScene sc = DEV_SCENE;
+    float3 org = vload3(0, ray), dir = normalize(vload3(0, ray + 4));
+    VbMedium state = f->camera_medium;
+    PathHit ph;
+    TraceCount tc = {0, 0};
+    TreeCount cnt = {0};
+    cnt.prune_budget = 0.0f;
+    int k = 0;
+    if (medium_trace(&sc, org, dir, INFINITY, &state, &ph, &tc, &cnt.passes)) {
+        TreeRay stack[VB_TREE_STACK];
+        int n = 0;
+        ShadePoint sp = shade_point_make(&sc, dir, ph.hit, 1u, state, ph.cx.surface);
+        tree_spawn(&sc, stack, &n, &sp, dir, &ph.cx, state, (float3)(1.0f), 1, &cnt, -1);
+        while (n > 0) {
+            TreeRay tr = stack[--n];
+            VbMedium st = tr.medium;
+            if (!medium_trace(&sc, tr.org, tr.dir, INFINITY, &st, &ph, &tc, &cnt.passes)) {
+                if (k < cap) {
+                    vstore4((float4)(tr.dir, (float)tr.band), 0, out + 8 * k);
+                    vstore4((float4)(tr.weight, (float)tr.depth), 0, out + 8 * k + 4);
+                }
+                k++;
+                continue;
+            }
+            ShadePoint q = shade_point_make(&sc, tr.dir, ph.hit, tr.key, st, ph.cx.surface);
+            if (materials[ph.cx.surface].k_global > 0.0f)
+                tree_spawn(&sc, stack, &n, &q, tr.dir, &ph.cx, st, tr.weight, tr.depth + 1, &cnt,
+                           tr.band);
+        }
+    }
+    *count = k;
+}
+#endif

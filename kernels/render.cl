@@ -200,8 +200,8 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
     cnt.prune_budget = f->min_weight;
     TraceCount tc = {0, 0};
     ShadowCount shc = {0, 0};
-    tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1,
-               &cnt);
+    tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
+               -1);
     float3 acc = (float3)(0.0f);
     while (n > 0) {
         TreeRay tr = stack[--n];
@@ -217,7 +217,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
         __global const VbMaterial *ms = materials + ph.cx.surface;
         if (ms->k_local > 0.0f) acc += w * light_shade_local(&sc, &q, &tc, &shc);
         if (ms->k_global > 0.0f)
-            tree_spawn(&sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, &cnt);
+            tree_spawn(&sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, &cnt, tr.band);
     }
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
     atomic_add(&counters[VBCL_COUNT_REFLECTED], cnt.reflected);
@@ -228,6 +228,10 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
     atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], cnt.passes);
     atomic_add(&counters[VBCL_COUNT_INTERFACES], cnt.interfaces);
     atomic_add(&counters[VBCL_COUNT_ENERGY_ERRORS], cnt.energy_errors);
+#ifdef VBCL_HAS_DISPERSION
+    if (cnt.splits) atomic_add(&counters[VBCL_COUNT_SPLITS], cnt.splits);
+    if (cnt.band_rays) atomic_add(&counters[VBCL_COUNT_BAND_RAYS], cnt.band_rays);
+#endif
     for (int d = 1; d < VBCL_COUNT_DEPTH_BINS; d++)
         if (cnt.by_depth[d]) atomic_add(&counters[VBCL_COUNT_DEPTH0 + d], cnt.by_depth[d]);
     atomic_add(&counters[VBCL_COUNT_SHADOW], shc.traced);

@@ -7,7 +7,8 @@
 
 /* Depth-first with at most one pending sibling per level: max_depth + 1 entries suffice.
  * The host compiles the stack for the next size class (8, 16, 32, 64) above the scene's
- * max_depth, so changing the depth rarely rebuilds the program. */
+ * max_depth, so changing the depth rarely rebuilds the program. With dispersion the level
+ * of a path's one split holds up to `bands` pending band rays: max_depth + 1 + bands. */
 #ifndef VBCL_TREE_STACK
 #define VBCL_TREE_STACK 8
 #endif
@@ -20,11 +21,13 @@ typedef struct TreeRay {
     VbMedium medium;
     int depth;
     uint key; /* from the branch's path, so pruning one branch leaves the others' jitter alone */
+    int band; /* the wavelength band it carries, or -1: all of them (white) */
 } TreeRay;
 
 /* What one sample's tree did, summed into the frame counters at the end. */
 typedef struct TreeCount {
     uint reflected, transmitted, pruned, depth_cut, tir, passes, interfaces, energy_errors;
+    uint splits, band_rays;
     uint by_depth[VBCL_COUNT_DEPTH_BINS];
     float prune_budget; /* weight this sample may still drop: starts at min_weight */
 } TreeCount;
@@ -36,7 +39,7 @@ typedef struct TreeCount {
  * min_weight / 1000 are dropped. */
 VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 w, VbMedium m,
                          int depth, uint key, __constant const VbFrame *f, TreeCount *cnt,
-                         int transmitted)
+                         int transmitted, int band)
 {
     float wm = vb_max3(w);
     if (wm <= 0.0f) return; /* no energy: nothing to trace or count */
@@ -56,7 +59,9 @@ VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 
     t.medium = m;
     t.depth = depth;
     t.key = key;
+    t.band = band;
     stack[(*n)++] = t;
+    cnt->band_rays += band >= 0;
     if (transmitted)
         cnt->transmitted++;
     else
@@ -64,22 +69,82 @@ VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 
     cnt->by_depth[min(depth, VBCL_COUNT_DEPTH_BINS - 1)]++;
 }
 
-/* Pushes the children of a ray that arrived along dir with weight w at the interface c
- * (seen at shading point sp, medium `before` on the incoming side). */
+#ifdef VBCL_HAS_DISPERSION
+/* A material's index in band b (its constant eta for white rays or without dispersion). */
+VB_INLINE float tree_eta(const DevScene *sc, uint m, int band)
+{
+    int d = sc->materials[m].disp;
+    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band] : sc->materials[m].eta;
+}
+
+/* Fraction of band b that material m lets in (its absorption band takes the rest). */
+VB_INLINE float tree_band_transmit(const DevScene *sc, uint m, int band)
+{
+    int d = sc->materials[m].disp;
+    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band + 1] : 1.0f;
+}
+#endif
+
+/* Pushes the children of a ray of band `band` (-1: white) that arrived along dir with
+ * weight w at the interface c (seen at shading point sp, medium `before` on the incoming
+ * side). A white ray refracting at an interface with a dispersive side splits: its
+ * transmitted part becomes one ray per band, weighted by the band's rgb weight and its own
+ * T; the reflected ray stays one white ray, weighted by the band-weighted sum of the R. */
 VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const ShadePoint *sp,
                           float3 dir, const Crossing *c, VbMedium before, float3 w, int depth,
-                          TreeCount *cnt)
+                          TreeCount *cnt, int band)
 {
     __global const VbMaterial *ms = sc->materials + c->surface;
-    OpticsSplit s = optics_split(dir, sp->ns, sp->ng, sc->materials[c->mat_before].eta,
-                                 sc->materials[c->mat_after].eta);
+    float3 wg = w * ms->k_global;
+#ifdef VBCL_HAS_DISPERSION
+    if (band < 0 &&
+        (sc->materials[c->mat_before].disp >= 0 || sc->materials[c->mat_after].disp >= 0)) {
+        OpticsSplit s0 = optics_split(dir, sp->ns, sp->ng, sc->materials[c->mat_before].eta,
+                                      sc->materials[c->mat_after].eta);
+        cnt->interfaces++;
+        if (s0.T > 0.0f) { /* a refraction: split into the bands */
+            cnt->splits++;
+            float3 wr = (float3)(0.0f);
+            for (int b = 0; b < sc->f->bands; b++) {
+                OpticsSplit s = optics_split(dir, sp->ns, sp->ng, tree_eta(sc, c->mat_before, b),
+                                             tree_eta(sc, c->mat_after, b));
+                wr += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) * s.R;
+            }
+            tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s0.reflected, wg * wr,
+                      before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
+            uint tkey = vb_hash(2u * sp->key + 2u);
+            for (int b = 0; b < sc->f->bands; b++) {
+                float3 bw = vb_gload3(sc->texels + sc->f->band_weights + 4 * b);
+                OpticsSplit s = optics_split(dir, sp->ns, sp->ng, tree_eta(sc, c->mat_before, b),
+                                             tree_eta(sc, c->mat_after, b));
+                cnt->tir += (uint)s.tir;
+                cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
+                if (s.T > 0.0f)
+                    tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
+                              wg * bw * (s.T * tree_band_transmit(sc, c->mat_after, b)), c->after,
+                              depth, vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
+            }
+            return;
+        }
+        cnt->tir += (uint)s0.tir;
+        tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s0.reflected, wg * s0.R,
+                  before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
+        return;
+    }
+    float eta1 = tree_eta(sc, c->mat_before, band), eta2 = tree_eta(sc, c->mat_after, band);
+    float tin = tree_band_transmit(sc, c->mat_after, band);
+#else
+    float eta1 = sc->materials[c->mat_before].eta, eta2 = sc->materials[c->mat_after].eta;
+    float tin = 1.0f;
+#endif
+    OpticsSplit s = optics_split(dir, sp->ns, sp->ng, eta1, eta2);
     cnt->tir += (uint)s.tir;
     cnt->interfaces++;
     cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
-    float3 wg = w * ms->k_global;
     tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s.reflected, wg * s.R, before,
-              depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0);
+              depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, band);
     if (s.T > 0.0f)
-        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted, wg * s.T,
-                  c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1);
+        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
+                  wg * (s.T * tin), c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1,
+                  band);
 }

@@ -17,7 +17,8 @@
 #define VBCL_FEATURE_ABSORPTION     (1u << 5) /* some dielectric absorbs (extinction > 0) */
 #define VBCL_FEATURE_FRESNEL_THESIS (1u << 6) /* split by thesis eq. 9, not Fresnel */
 #define VBCL_FEATURE_PATTERNS       (1u << 7) /* some material has a surface pattern */
-#define VBCL_FEATURE_COUNT          8
+#define VBCL_FEATURE_DISPERSION     (1u << 8) /* some dielectric's eta depends on wavelength */
+#define VBCL_FEATURE_COUNT          9
 
 /* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
 #define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
@@ -48,6 +49,8 @@
 #define VBCL_COUNT_PASS_THROUGH    10 /* crossings that changed no material */
 #define VBCL_COUNT_INTERFACES      11 /* interfaces where the tree split energy */
 #define VBCL_COUNT_ENERGY_ERRORS   12 /* of those, |R + T - 1| > 1e-5 (should stay 0) */
+#define VBCL_COUNT_SPLITS          13 /* white rays split into bands at a dispersive refraction */
+#define VBCL_COUNT_BAND_RAYS       14 /* rays traced that carry one wavelength band */
 #define VBCL_COUNT_DEPTH0          16 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS      16
 #define VBCL_COUNTERS              32
@@ -96,7 +99,9 @@ typedef struct VbMaterial {
     float k_global;      /* weight of reflected + transmitted light */
     float eta;           /* refractive index */
     int pattern;         /* index into the patterns, or -1 */
-    int pad[3];
+    int disp;            /* dispersion: first float of its band table in the side data
+                          * (texels): per band (eta, transmitted fraction, 0, 0); -1: none */
+    int pad[2];
 } VbMaterial;
 
 /* A material's surface pattern: at a hit point p, texture coordinates
@@ -192,7 +197,10 @@ typedef struct VbFrame {
     unsigned int air_material; /* index of the material outside every host */
     float min_weight;          /* branches whose weight is below this in every channel stop */
     int max_depth;             /* deepest ray-tree level traced (primary rays: 0) */
-    float pad[3];
+    int bands;                 /* wavelength bands of a dispersive split */
+    unsigned int band_weights; /* first float of the bands' rgb weights (4 floats each) in the
+                                * side data (texels) */
+    float pad;
 } VbFrame;
 
 VBCL_STATIC_ASSERT(sizeof(VbRay) == 32, ray_size);
@@ -207,6 +215,7 @@ VBCL_STATIC_ASSERT(sizeof(VbPattern) == 48 + 240, pattern_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbPattern, fourier) == 48, pattern_fourier);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, exponent) == 64, material_exponent);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, eta) == 76, material_eta);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, disp) == 84, material_disp);
 VBCL_STATIC_ASSERT(sizeof(VbLight) == 32, light_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLight, radiance) == 16, light_radiance);
 VBCL_STATIC_ASSERT(sizeof(VbCamera) == 64, camera_size);
@@ -218,6 +227,8 @@ VBCL_STATIC_ASSERT(sizeof(VbFrame) == 240, frame_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, max_depth) == 224, frame_max_depth);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, camera_medium) == 208, frame_camera_medium);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, min_weight) == 220, frame_min_weight);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, bands) == 228, frame_bands);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, band_weights) == 232, frame_band_weights);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, grid) == 64, frame_grid);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, background) == 144, frame_background);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, width) == 176, frame_width);

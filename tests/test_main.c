@@ -108,5 +108,6 @@ int main(int argc, char **argv)
     suite_stability();
     suite_render();
     suite_aa();
+    suite_dispersion();
     return th_summary();
 }

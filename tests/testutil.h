@@ -35,5 +35,6 @@ void suite_patterns(void);
 void suite_stability(void);
 void suite_render(void);
 void suite_aa(void);
+void suite_dispersion(void);
 
 #endif
