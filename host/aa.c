@@ -10,26 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
-{
-    cl_int rc = clSetKernelArg(k, i, size, val);
-    if (rc == CL_SUCCESS) return 0;
-    char what[64];
-    snprintf(what, sizeof what, "clSetKernelArg(argument %u)", i);
-    return clu_fail(rc, what, __FILE__, __LINE__);
-}
-
-static cl_mem buffer(VbDevice *d, size_t bytes)
-{
-    cl_int rc;
-    cl_mem m = clCreateBuffer(d->context, CL_MEM_READ_WRITE, bytes, NULL, &rc);
-    if (rc != CL_SUCCESS) {
-        clu_fail(rc, "clCreateBuffer", __FILE__, __LINE__);
-        return NULL;
-    }
-    return m;
-}
-
 /* Creates the anti-aliasing kernels and buffers (film, level map, mark list) once.
  * Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
 static int aa_setup(Renderer *r, const Scene *s, char *err, size_t errlen)
@@ -55,11 +35,11 @@ static int aa_setup(Renderer *r, const Scene *s, char *err, size_t errlen)
     renderer_fit_local_size(r, r->k_aa_generate);
     renderer_fit_local_size(r, r->k_aa_contrast);
     renderer_fit_local_size(r, r->k_aa_reconstruct);
-    r->aa_pass = buffer(d, sizeof(VbAaPass));
-    r->film = buffer(d, sizeof(float) * 4 * npix);
-    r->levels = buffer(d, sizeof(cl_int) * npix);
-    r->marks = buffer(d, sizeof(cl_uint) * npix);
-    r->mark_counts = buffer(d, sizeof(cl_uint) * VBCL_AA_MAX_LEVEL);
+    r->aa_pass = clu_buffer(d, NULL, sizeof(VbAaPass), CL_MEM_READ_WRITE);
+    r->film = clu_buffer(d, NULL, sizeof(float) * 4 * npix, CL_MEM_READ_WRITE);
+    r->levels = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    r->marks = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
+    r->mark_counts = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, CL_MEM_READ_WRITE);
     if (!r->aa_pass || !r->film || !r->levels || !r->marks || !r->mark_counts) goto fail;
     return 0;
 fail:
@@ -92,8 +72,8 @@ static int aa_run_batches(Renderer *r, VbAaPass *pass, unsigned first, unsigned 
         const cl_uint a = RENDER_SCENE_ARGS + 6;
         if (renderer_set_frame_args(r, r->k_aa_generate, r->rays, nrays, r->hits, r->media,
                                     r->radiance, r->counters) ||
-            set_arg(r->k_aa_generate, a, sizeof(cl_mem), &r->aa_pass) ||
-            set_arg(r->k_aa_generate, a + 1, sizeof(cl_mem), &r->marks))
+            clu_set_arg(r->k_aa_generate, a, sizeof(cl_mem), &r->aa_pass) ||
+            clu_set_arg(r->k_aa_generate, a + 1, sizeof(cl_mem), &r->marks))
             goto fail;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_generate, 1, NULL, &g_rays,
                                         renderer_local(r, g_rays), 0, NULL, &ev[0]),
@@ -102,7 +82,7 @@ static int aa_run_batches(Renderer *r, VbAaPass *pass, unsigned first, unsigned 
         if (renderer_trace_rays(r, nrays, st, &trace_ms)) goto fail;
         const cl_mem args[5] = {r->aa_pass, r->marks, r->radiance, r->film, r->levels};
         for (cl_uint i = 0; i < 5; i++)
-            if (set_arg(r->k_aa_reconstruct, i, sizeof(cl_mem), &args[i])) goto fail;
+            if (clu_set_arg(r->k_aa_reconstruct, i, sizeof(cl_mem), &args[i])) goto fail;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_reconstruct, 1, NULL, &g_pix,
                                         renderer_local(r, g_pix), 0, NULL, &ev[1]),
                  fail);
@@ -137,7 +117,7 @@ static int aa_mark(Renderer *r, const Scene *s, VbAaPass *pass, cl_uint counts[]
              fail);
     const cl_mem args[5] = {r->aa_pass, r->film, r->levels, r->marks, r->mark_counts};
     for (cl_uint i = 0; i < 5; i++)
-        if (set_arg(r->k_aa_contrast, i, sizeof(cl_mem), &args[i])) goto fail;
+        if (clu_set_arg(r->k_aa_contrast, i, sizeof(cl_mem), &args[i])) goto fail;
     CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_contrast, 1, NULL, &global,
                                     renderer_local(r, global), 0, NULL, &ev),
              fail);

@@ -367,3 +367,30 @@ fail_program:
 fail:
     return NULL;
 }
+
+cl_mem clu_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags)
+{
+    cl_int rc;
+    /* zero-sized buffers are invalid: keep at least 16 bytes */
+    static const char zeros[16];
+    if (bytes == 0) {
+        bytes = sizeof zeros;
+        data = zeros;
+    }
+    cl_mem m = clCreateBuffer(d->context, flags | (data ? CL_MEM_COPY_HOST_PTR : 0), bytes,
+                              (void *)data, &rc);
+    if (rc != CL_SUCCESS) {
+        clu_fail(rc, "clCreateBuffer", __FILE__, __LINE__);
+        return NULL;
+    }
+    return m;
+}
+
+int clu_set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
+{
+    cl_int rc = clSetKernelArg(k, i, size, val);
+    if (rc == CL_SUCCESS) return 0;
+    char what[64];
+    snprintf(what, sizeof what, "clSetKernelArg(argument %u)", i);
+    return clu_fail(rc, what, __FILE__, __LINE__);
+}

@@ -75,6 +75,13 @@ void clu_device_close(VbDevice *d);
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
                              int *cached);
 
+/* A buffer of `bytes` (at least 16: zero-sized buffers are invalid), initialised from data
+ * when not NULL. Returns NULL with the failure recorded (clu_error). */
+cl_mem clu_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags);
+
+/* clSetKernelArg, recording a failure with the argument's index; returns 0 or -1. */
+int clu_set_arg(cl_kernel k, cl_uint i, size_t size, const void *val);
+
 /* Milliseconds between the start and end of a completed, profiled event (0 on error). */
 double clu_event_ms(cl_event ev);
 

@@ -81,24 +81,6 @@ static VbTriNormals *pack_normals(const Scene *s)
     return t;
 }
 
-static cl_mem upload(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags)
-{
-    cl_int rc;
-    /* zero-sized buffers are invalid: keep at least 16 bytes */
-    static const char zeros[16];
-    if (bytes == 0) {
-        bytes = sizeof zeros;
-        data = zeros;
-    }
-    cl_mem m = clCreateBuffer(d->context, flags | (data ? CL_MEM_COPY_HOST_PTR : 0), bytes,
-                              (void *)data, &rc);
-    if (rc != CL_SUCCESS) {
-        clu_fail(rc, "clCreateBuffer", __FILE__, __LINE__);
-        return NULL;
-    }
-    return m;
-}
-
 /* Builds the materials' surface patterns (Fourier coefficients, projected images) and
  * uploads them; sets mats[i].pattern. Returns 0, 2 (a pattern the scene cannot have, the
  * message naming the material) or 1 (device). */
@@ -192,8 +174,8 @@ static int upload_patterns(Renderer *r, const Scene *s, VbMaterial *mats, char *
         for (int i = 0; i < s->nmaterials; i++) mats[i].disp = -1;
     }
     if (!rc) {
-        r->patterns = upload(r->dev, pats, sizeof *pats * (size_t)npats, CL_MEM_READ_ONLY);
-        r->texels = upload(r->dev, texels, sizeof(float) * 4 * ntexels, CL_MEM_READ_ONLY);
+        r->patterns = clu_buffer(r->dev, pats, sizeof *pats * (size_t)npats, CL_MEM_READ_ONLY);
+        r->texels = clu_buffer(r->dev, texels, sizeof(float) * 4 * ntexels, CL_MEM_READ_ONLY);
         if (!r->patterns || !r->texels) {
             snprintf(err, errlen, "%s: %s", r->dev->name, clu_error());
             rc = 1;
@@ -204,22 +186,13 @@ static int upload_patterns(Renderer *r, const Scene *s, VbMaterial *mats, char *
     return rc;
 }
 
-static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *val)
-{
-    cl_int rc = clSetKernelArg(k, i, size, val);
-    if (rc == CL_SUCCESS) return 0;
-    char what[64];
-    snprintf(what, sizeof what, "clSetKernelArg(argument %u)", i);
-    return clu_fail(rc, what, __FILE__, __LINE__);
-}
-
 int renderer_set_scene_args(const Renderer *r, cl_kernel k)
 {
     const cl_mem *m[RENDER_SCENE_ARGS] = {&r->frame,     &r->tris,      &r->normals, &r->cell_start,
                                           &r->cell_tris, &r->materials, &r->objects, &r->lights,
                                           &r->patterns,  &r->texels};
     for (cl_uint i = 0; i < RENDER_SCENE_ARGS; i++)
-        if (set_arg(k, i, sizeof(cl_mem), m[i])) return -1;
+        if (clu_set_arg(k, i, sizeof(cl_mem), m[i])) return -1;
     return 0;
 }
 
@@ -227,10 +200,12 @@ int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nra
                             cl_mem media, cl_mem radiance, cl_mem counters)
 {
     const cl_uint a = RENDER_SCENE_ARGS;
-    if (renderer_set_scene_args(r, k) || set_arg(k, a, sizeof(cl_mem), &rays) ||
-        set_arg(k, a + 1, sizeof(int), &nrays) || set_arg(k, a + 2, sizeof(cl_mem), &hits) ||
-        set_arg(k, a + 3, sizeof(cl_mem), &media) || set_arg(k, a + 4, sizeof(cl_mem), &radiance) ||
-        set_arg(k, a + 5, sizeof(cl_mem), &counters))
+    if (renderer_set_scene_args(r, k) || clu_set_arg(k, a, sizeof(cl_mem), &rays) ||
+        clu_set_arg(k, a + 1, sizeof(int), &nrays) ||
+        clu_set_arg(k, a + 2, sizeof(cl_mem), &hits) ||
+        clu_set_arg(k, a + 3, sizeof(cl_mem), &media) ||
+        clu_set_arg(k, a + 4, sizeof(cl_mem), &radiance) ||
+        clu_set_arg(k, a + 5, sizeof(cl_mem), &counters))
         return -1;
     return 0;
 }
@@ -310,17 +285,17 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
         renderer_release(r);
         return 2;
     }
-    r->tris = upload(dev, tris, nbytes_tris, CL_MEM_READ_ONLY);
-    r->normals = upload(
+    r->tris = clu_buffer(dev, tris, nbytes_tris, CL_MEM_READ_ONLY);
+    r->normals = clu_buffer(
         dev, normals,
         (r->features & VBCL_FEATURE_SMOOTH_NORMALS) ? sizeof(VbTriNormals) * s->mesh.ntris : 0,
         CL_MEM_READ_ONLY);
     free(tris);
     free(normals);
-    r->cell_start =
-        upload(dev, r->grid.cell_start, sizeof(uint32_t) * (r->grid.ncells + 1u), CL_MEM_READ_ONLY);
+    r->cell_start = clu_buffer(dev, r->grid.cell_start, sizeof(uint32_t) * (r->grid.ncells + 1u),
+                               CL_MEM_READ_ONLY);
     r->cell_tris =
-        upload(dev, r->grid.cell_tris, sizeof(uint32_t) * r->grid.nrefs, CL_MEM_READ_ONLY);
+        clu_buffer(dev, r->grid.cell_tris, sizeof(uint32_t) * r->grid.nrefs, CL_MEM_READ_ONLY);
     /* the scene's materials, then the medium outside every host: vacuum, eta 1 */
     VbMaterial *mats = calloc((size_t)s->nmaterials + 1, sizeof *mats);
     VbObject *objs = calloc((size_t)s->nobjects, sizeof *objs);
@@ -348,11 +323,12 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
         objs[i].tex_slot = o->tex_slot;
         objs[i].flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
     }
-    r->materials = upload(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
-    r->objects = upload(dev, objs, sizeof *objs * (size_t)s->nobjects, CL_MEM_READ_ONLY);
+    r->materials =
+        clu_buffer(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
+    r->objects = clu_buffer(dev, objs, sizeof *objs * (size_t)s->nobjects, CL_MEM_READ_ONLY);
     free(mats);
     free(objs);
-    r->lights = upload(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
+    r->lights = clu_buffer(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
     if (!r->tris || !r->normals || !r->cell_start || !r->cell_tris || !r->materials ||
         !r->objects || !r->lights)
         goto fail;
@@ -377,7 +353,7 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     f->max_depth = s->max_depth;
     f->bands = s->bands;
     f->band_weights = r->band_weights;
-    r->frame = upload(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
+    r->frame = clu_buffer(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
 
     /* tiles: bounded so that 32-bit work counters of one tile cannot overflow */
     long npix = (long)s->width * s->height;
@@ -389,11 +365,11 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     /* supersampling batches hold at least one pixel's 16x16 samples */
     long cap = tile < AA_MIN_BATCH_RAYS ? AA_MIN_BATCH_RAYS : tile;
     r->ray_capacity = (int)cap;
-    r->rays = upload(dev, NULL, sizeof(VbRay) * (size_t)cap, CL_MEM_READ_WRITE);
-    r->hits = upload(dev, NULL, sizeof(VbHit) * (size_t)cap, CL_MEM_READ_WRITE);
-    r->radiance = upload(dev, NULL, sizeof(float) * 4 * (size_t)cap, CL_MEM_READ_WRITE);
-    r->media = upload(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
-    r->counters = upload(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
+    r->rays = clu_buffer(dev, NULL, sizeof(VbRay) * (size_t)cap, CL_MEM_READ_WRITE);
+    r->hits = clu_buffer(dev, NULL, sizeof(VbHit) * (size_t)cap, CL_MEM_READ_WRITE);
+    r->radiance = clu_buffer(dev, NULL, sizeof(float) * 4 * (size_t)cap, CL_MEM_READ_WRITE);
+    r->media = clu_buffer(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
+    r->counters = clu_buffer(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
     if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->media || !r->counters) goto fail;
     st->upload_ms = clu_now_ms() - t0;
     st->tile_pixels = r->tile_pixels;
