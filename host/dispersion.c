@@ -15,6 +15,14 @@ void disp_cauchy_from_abbe(DispModel *m, double n_d, double abbe)
     m->a = n_d - m->b / (ld * ld);
 }
 
+void disp_thesis_model(DispModel *m, double eta_670, double spread)
+{
+    double l4 = 0.4, l7 = 0.7, ll = DISP_LAMBDA_LITHIUM * 1e-3; /* µm */
+    m->model = DISP_THESIS;
+    m->b = spread / (1.0 / (l4 * l4) - 1.0 / (l7 * l7));
+    m->a = eta_670 - m->b / (ll * ll);
+}
+
 int disp_sellmeier_preset(DispModel *m, const char *name)
 {
     /* Schott optical glass catalogue coefficients (λ in µm, C in µm²). */
@@ -38,7 +46,7 @@ int disp_sellmeier_preset(DispModel *m, const char *name)
 double disp_eta(const DispModel *m, double lambda_nm)
 {
     double l = lambda_nm * 1e-3, l2 = l * l, n = 1.0;
-    if (m->model == DISP_CAUCHY) {
+    if (m->model == DISP_CAUCHY || m->model == DISP_THESIS) {
         n = m->a + m->b / l2;
     } else if (m->model == DISP_SELLMEIER) {
         double n2 = 1.0;
@@ -136,6 +144,45 @@ void disp_band_weights(int n, float rgb[][3])
     }
     for (int b = 0; b < n; b++)
         for (int r = 0; r < 3; r++) rgb[b][r] = (float)(w[b][r] / sum[r]);
+}
+
+/* k rays over [lo, hi] nm at equal steps of 1/λ²: sub-band j's edges and the λ at the
+ * midpoint of its 1/λ² interval. */
+static void thesis_channel(DispBand *out, double lo, double hi, int k, const float rgb[3])
+{
+    double ua = 1.0 / (hi * hi), ub = 1.0 / (lo * lo);
+    for (int j = 0; j < k; j++) {
+        double u0 = ua + (ub - ua) * j / k, u1 = ua + (ub - ua) * (j + 1) / k;
+        DispBand *b = out + (k - 1 - j); /* ascending wavelength */
+        b->lo = 1.0 / sqrt(u1);
+        b->hi = 1.0 / sqrt(u0);
+        b->centre = 1.0 / sqrt(0.5 * (u0 + u1));
+        for (int c = 0; c < 3; c++) b->rgb[c] = rgb[c] / (float)k;
+    }
+}
+
+int disp_layout_bands(int layout, int n, DispBand *out)
+{
+    if (layout == DISP_LAYOUT_THESIS) {
+        static const float blue[3] = {0, 0, 1}, green[3] = {0, 1, 0};
+        thesis_channel(out, DISP_LAMBDA_MIN, 500.0, 3, blue);
+        thesis_channel(out + 3, 500.0, 600.0, 2, green);
+        DispBand *red = out + 5; /* one ray, at the wavelength the given eta is measured at */
+        red->lo = 600.0;
+        red->hi = DISP_LAMBDA_MAX;
+        red->centre = DISP_LAMBDA_LITHIUM;
+        red->rgb[0] = 1.0f;
+        red->rgb[1] = red->rgb[2] = 0.0f;
+        return DISP_THESIS_BANDS;
+    }
+    float w[DISP_MAX_BANDS][3];
+    disp_band_weights(n, w);
+    for (int b = 0; b < n; b++) {
+        disp_band_edges(n, b, &out[b].lo, &out[b].hi);
+        out[b].centre = 0.5 * (out[b].lo + out[b].hi);
+        memcpy(out[b].rgb, w[b], sizeof out[b].rgb);
+    }
+    return n;
 }
 
 double disp_prism_deviation(double n, double apex_deg, double inc_deg)

@@ -27,7 +27,11 @@ static const char usage_text[] =
     "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float).\n"
     "\n"
     "options (each overrides the scene's own setting):\n"
-    "  -o, --output FILE        image to write (default: image.output, else SCENE.png)\n"
+    "  -o, --output FILE        image to write (default: image.output, else SCENE.png);\n"
+    "                           frames of an animation are numbered: a run of # in FILE\n"
+    "                           becomes the frame number, else FILE_0007.png\n"
+    "      --frames A:B         render frames A to B of an animated scene (or one: N);\n"
+    "                           default: all of them\n"
     "      --width N            image width in pixels (1..16384)\n"
     "      --height N           image height in pixels (1..16384)\n"
     "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto)\n"
@@ -40,7 +44,8 @@ static const char usage_text[] =
     "      --aa THRESHOLD       adaptive anti-aliasing: refine pixels whose contrast\n"
     "                           |a-b|/(a+b) with a neighbour exceeds THRESHOLD (0..1; 0 off)\n"
     "      --aa-max-level L     deepest refinement, 2^L x 2^L samples per pixel (1..4)\n"
-    "      --bands N            wavelength bands of a dispersive refraction (1..64)\n"
+    "      --bands N|thesis     wavelength bands of a dispersive refraction (1..64), or the\n"
+    "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
@@ -59,6 +64,7 @@ static const char usage_text[] =
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map;
+    int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
     double grid_density, exposure, min_weight, aa;
     int have_exposure;
@@ -111,6 +117,7 @@ static int parse_args(int argc, char **argv, Options *o)
     o->width = o->height = o->shadow_samples = o->depth = -1;
     o->grid_density = o->min_weight = o->aa = -1;
     o->aa_max_level = o->ssaa = o->bands = -1;
+    o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -128,6 +135,20 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             NEEDS_VALUE;
             o->output = val;
+        } else if (!strcmp(a, "--frames")) {
+            NEEDS_VALUE;
+            char *end;
+            errno = 0;
+            long f0 = strtol(val, &end, 10), f1 = f0;
+            if (end != val && *end == ':') {
+                const char *b = end + 1;
+                f1 = strtol(b, &end, 10);
+                if (end == b) f1 = -1;
+            }
+            if (end == val || *end || errno || f0 < 0 || f1 < f0 || f1 > 100000)
+                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", val);
+            o->frame_first = (int)f0;
+            o->frame_last = (int)f1;
         } else if (!strcmp(a, "--width")) {
             NEEDS_VALUE;
             if (parse_int(a, val, 1, SCENE_MAX_IMAGE, &o->width)) return 2;
@@ -166,7 +187,10 @@ static int parse_args(int argc, char **argv, Options *o)
             if (parse_int(a, val, 1, VBCL_AA_MAX_LEVEL, &o->aa_max_level)) return 2;
         } else if (!strcmp(a, "--bands")) {
             NEEDS_VALUE;
-            if (parse_int(a, val, 1, DISP_MAX_BANDS, &o->bands)) return 2;
+            if (!strcmp(val, "thesis"))
+                o->bands = 0; /* the thesis layout */
+            else if (parse_int(a, val, 1, DISP_MAX_BANDS, &o->bands))
+                return 2;
         } else if (!strcmp(a, "--ssaa")) {
             NEEDS_VALUE;
             if (parse_int(a, val, 1, 16, &o->ssaa)) return 2;
@@ -195,11 +219,33 @@ static int parse_args(int argc, char **argv, Options *o)
     return -1;
 }
 
-/* The output path: -o, else image.output, else the scene's base name with .png. */
-static char *output_path(const Options *o, const Scene *s)
+/* The path of frame `frame` (-1: not an animation): a run of '#' in path becomes the frame
+ * number, zero-padded to the run's length; without one, _NNNN goes before the extension. */
+static char *frame_path(const char *path, int frame)
 {
-    if (o->output) return strdup(o->output);
-    if (s->output) return strdup(s->output);
+    if (frame < 0) return strdup(path);
+    size_t n = strlen(path);
+    char *out = malloc(n + 16);
+    if (!out) return NULL;
+    const char *hash = strchr(path, '#');
+    const char *slash = strrchr(path, '/');
+    if (hash && (!slash || hash > slash)) {
+        size_t run = strspn(hash, "#");
+        snprintf(out, n + 16, "%.*s%0*d%s", (int)(hash - path), path, (int)run, frame, hash + run);
+    } else {
+        const char *dot = strrchr(path, '.');
+        if (!dot || (slash && dot < slash)) dot = path + n;
+        snprintf(out, n + 16, "%.*s_%04d%s", (int)(dot - path), path, frame, dot);
+    }
+    return out;
+}
+
+/* The output path: -o, else image.output, else the scene's base name with .png; numbered
+ * for the frames of an animation. */
+static char *output_path(const Options *o, const Scene *s, int frame)
+{
+    if (o->output) return frame_path(o->output, frame);
+    if (s->output) return frame_path(s->output, frame);
     const char *base = strrchr(o->scene, '/');
     base = base ? base + 1 : o->scene;
     size_t n = strlen(base);
@@ -209,6 +255,11 @@ static char *output_path(const Options *o, const Scene *s)
     if (out) {
         memcpy(out, base, n);
         memcpy(out + n, ".png", 5);
+    }
+    if (out && frame >= 0) {
+        char *numbered = frame_path(out, frame);
+        free(out);
+        out = numbered;
     }
     return out;
 }
@@ -220,7 +271,8 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
     features_describe(st->features, feat, sizeof feat);
     unsigned long long rays =
         st->rays_primary + st->rays_refine + st->rays_shadow + st->reflected + st->transmitted;
-    double kernel_ms = st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms;
+    double kernel_ms =
+        st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms + st->dispersion_ms;
     unsigned strata = r->frame_host.shadow_strata;
     fprintf(stderr, "scene       %s: %d objects, %u triangles, %d materials, %d lights\n", s->path,
             s->nobjects, s->mesh.ntris, s->nmaterials, s->nlights);
@@ -250,8 +302,12 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
         fprintf(stderr, "energy      %llu interfaces split, %llu with |R + T - 1| > 1e-5\n",
                 st->interfaces, st->energy_errors);
         if (st->features & VBCL_FEATURE_DISPERSION)
-            fprintf(stderr, "dispersion  %llu rays split into %d bands, %llu band rays traced\n",
-                    st->splits, s->bands, st->band_rays);
+            fprintf(stderr,
+                    "dispersion  %llu rays split into %d bands%s, %llu band rays traced, %.1f ms "
+                    "in dispersive subtrees (device)\n",
+                    st->splits, s->bands,
+                    s->band_layout == DISP_LAYOUT_THESIS ? " (thesis: 1 red, 2 green, 3 blue)" : "",
+                    st->band_rays, st->dispersion_ms);
         fprintf(stderr, "by depth   ");
         for (int k = 0; k < VBCL_COUNT_DEPTH_BINS; k++)
             if (st->by_depth[k])
@@ -287,10 +343,10 @@ static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, co
     fprintf(
         stderr,
         "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f ms, "
-        "ray trees %.1f ms, readback %.1f ms (device) | render %.1f ms, write %.1f ms, total %.1f "
-        "ms (wall)\n",
+        "ray trees %.1f ms, dispersive subtrees %.1f ms, readback %.1f ms (device) | render %.1f "
+        "ms, write %.1f ms, total %.1f ms (wall)\n",
         st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->tree_ms,
-        st->readback_ms, st->render_ms, write_ms, total_ms);
+        st->dispersion_ms, st->readback_ms, st->render_ms, write_ms, total_ms);
     fprintf(stderr, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
             kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
 }
@@ -314,63 +370,60 @@ static int write_aa_map(const char *path, const Scene *s, const int *levels, cha
     return rc;
 }
 
-int main(int argc, char **argv)
+/* The command line's settings over the scene's own. Returns 0, or 2 after a usage error. */
+static int apply_options(const Options *o, Scene *s)
 {
-    if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
-    scene_texgen = texgen_run_quiet;
-    double t0 = clu_now_ms();
-    Options o;
-    int rc = parse_args(argc, argv, &o);
-    if (rc >= 0) return rc;
-    if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
+    if (o->width > 0) s->width = o->width;
+    if (o->height > 0) s->height = o->height;
+    if (o->shadow_samples > 0) s->shadow_samples = o->shadow_samples;
+    if (o->grid_density > 0) s->grid_density = (float)o->grid_density;
+    if (o->have_exposure) s->exposure = (float)o->exposure;
+    if (o->depth > 0) s->max_depth = o->depth;
+    if (o->min_weight >= 0) s->min_weight = (float)o->min_weight;
+    if (o->aa >= 0) s->aa_threshold = (float)o->aa;
+    if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
+    if (o->bands >= 0) {
+        s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;
+        s->bands = o->bands ? o->bands : DISP_THESIS_BANDS;
+    }
+    if (o->ssaa > 0) s->ssaa = o->ssaa;
+    if (s->ssaa > 1 && s->aa_threshold > 0.0f) {
+        if (o->aa > 0) return usage_error("%s", "--aa and --ssaa exclude each other");
+        s->aa_threshold = 0.0f; /* --ssaa overrides the scene's render.aa */
+    }
+    if (o->aa_map && !(s->aa_threshold > 0.0f))
+        return usage_error("%s", "--aa-map needs adaptive anti-aliasing (--aa or render.aa)");
+    if (o->fresnel)
+        s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
+    if (o->grid && scene_parse_grid(o->grid, s->grid_res))
+        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o->grid);
+    return 0;
+}
 
+/* Renders frame `frame` of the scene (-1: a scene that is not animated) on dev and writes
+ * it; t0 is when this frame's work began. Returns an exit status. */
+static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
+{
     char err[1024] = "";
     Scene s;
-    if (scene_load(o.scene, &s, err, sizeof err)) {
+    if (scene_load_frame(o->scene, frame, &s, err, sizeof err)) {
         fprintf(stderr, "vbcl: %s\n", err);
         return 2;
     }
-    if (o.width > 0) s.width = o.width;
-    if (o.height > 0) s.height = o.height;
-    if (o.shadow_samples > 0) s.shadow_samples = o.shadow_samples;
-    if (o.grid_density > 0) s.grid_density = (float)o.grid_density;
-    if (o.have_exposure) s.exposure = (float)o.exposure;
-    if (o.depth > 0) s.max_depth = o.depth;
-    if (o.min_weight >= 0) s.min_weight = (float)o.min_weight;
-    if (o.aa >= 0) s.aa_threshold = (float)o.aa;
-    if (o.aa_max_level > 0) s.aa_max_level = o.aa_max_level;
-    if (o.bands > 0) s.bands = o.bands;
-    if (o.ssaa > 0) s.ssaa = o.ssaa;
-    if (s.ssaa > 1 && s.aa_threshold > 0.0f) {
-        if (o.aa > 0) {
-            scene_free(&s);
-            return usage_error("%s", "--aa and --ssaa exclude each other");
-        }
-        s.aa_threshold = 0.0f; /* --ssaa overrides the scene's render.aa */
-    }
-    if (o.aa_map && !(s.aa_threshold > 0.0f)) {
-        scene_free(&s);
-        return usage_error("%s", "--aa-map needs adaptive anti-aliasing (--aa or render.aa)");
-    }
-    if (o.fresnel)
-        s.fresnel = strcmp(o.fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
-    if (o.grid && scene_parse_grid(o.grid, s.grid_res)) {
-        scene_free(&s);
-        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o.grid);
-    }
-    char *out = output_path(&o, &s);
+    int rc = apply_options(o, &s);
+    char *out = rc ? NULL : output_path(o, &s, frame);
+    char *map = (rc || !o->aa_map) ? NULL : frame_path(o->aa_map, frame);
     float *rgba = NULL;
-    VbDevice dev = {0};
     Renderer r = {0};
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (!out) {
+    if (rc) goto done_scene;
+    if (!out || (o->aa_map && !map)) {
         fprintf(stderr, "vbcl: out of memory\n");
         rc = 1;
         goto done_scene;
     }
-    if (image_check_path(out, err, sizeof err) ||
-        (o.aa_map && image_check_path(o.aa_map, err, sizeof err))) {
+    if (image_check_path(out, err, sizeof err) || (map && image_check_path(map, err, sizeof err))) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 2;
         goto done_scene;
@@ -381,18 +434,12 @@ int main(int argc, char **argv)
         rc = 1;
         goto done_scene;
     }
-    const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-    rc = clu_device_open(spec, &dev, err, sizeof err);
+    rc = renderer_init(&r, dev, &s, NULL, &st, err, sizeof err);
     if (rc) {
         fprintf(stderr, "vbcl: %s\n", err);
-        goto done_scene;
+        goto done_renderer;
     }
-    rc = renderer_init(&r, &dev, &s, NULL, &st, err, sizeof err);
-    if (rc) {
-        fprintf(stderr, "vbcl: %s\n", err);
-        goto done_device;
-    }
-    int progress = !o.quiet && isatty(STDERR_FILENO);
+    int progress = !o->quiet && isatty(STDERR_FILENO);
     if (renderer_render(&r, &s, rgba, &st, progress, err, sizeof err)) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 1;
@@ -404,28 +451,80 @@ int main(int argc, char **argv)
         rc = 1;
         goto done_renderer;
     }
-    if (o.aa_map && r.aa_levels && write_aa_map(o.aa_map, &s, r.aa_levels, err, sizeof err)) {
+    if (map && r.aa_levels && write_aa_map(map, &s, r.aa_levels, err, sizeof err)) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 1;
         goto done_renderer;
     }
     double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
-    if (o.stats) print_stats(&s, &dev, &r, &st, write_ms, total_ms);
-    if (!o.quiet) {
+    if (o->stats) {
+        if (frame >= 0) fprintf(stderr, "frame       %d of %d\n", frame, s.frames);
+        print_stats(&s, dev, &r, &st, write_ms, total_ms);
+    }
+    if (!o->quiet) {
         unsigned long long rays =
             st.rays_primary + st.rays_refine + st.rays_shadow + st.reflected + st.transmitted;
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s.width, s.height, total_ms / 1000.0, s.mesh.ntris, rays,
-               st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev.name);
+               st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev->name);
+        fflush(stdout);
     }
     rc = 0;
 done_renderer:
     renderer_release(&r);
-done_device:
-    clu_device_close(&dev);
 done_scene:
     free(rgba);
     free(out);
+    free(map);
     scene_free(&s);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
+    scene_texgen = texgen_run_quiet;
+    double t0 = clu_now_ms();
+    Options o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc >= 0) return rc;
+    if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
+
+    /* the scene as written: checked before any device is opened; its frame count */
+    char err[1024] = "";
+    Scene s;
+    if (scene_load(o.scene, &s, err, sizeof err)) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        return 2;
+    }
+    int frames = s.frames, animated = s.animated;
+    rc = apply_options(&o, &s);
+    scene_free(&s);
+    if (rc) return rc;
+    int first = 0, last = frames - 1;
+    if (o.frame_first >= 0) {
+        if (!animated) return usage_error("--frames: %s is not animated", o.scene);
+        first = o.frame_first;
+        last = o.frame_last < 0 ? frames - 1 : o.frame_last;
+        if (last >= frames)
+            return usage_error("--frames %d:%d: %s has frames 0 to %d", first, last, o.scene,
+                               frames - 1);
+    }
+    VbDevice dev = {0};
+    const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
+    rc = clu_device_open(spec, &dev, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "vbcl: %s\n", err);
+        return rc;
+    }
+    if (!animated) {
+        rc = render_frame(&o, -1, &dev, t0);
+    } else {
+        for (int f = first; f <= last && rc == 0; f++) {
+            rc = render_frame(&o, f, &dev, t0);
+            t0 = clu_now_ms();
+        }
+    }
+    clu_device_close(&dev);
     return rc;
 }

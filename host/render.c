@@ -146,26 +146,22 @@ static int upload_patterns(Renderer *r, const Scene *s, VbMaterial *mats, char *
             snprintf(err, errlen, "out of memory for the band tables");
         } else {
             texels = grown;
-            float w[DISP_MAX_BANDS][3];
-            disp_band_weights(nb, w);
+            DispBand band[DISP_MAX_BANDS];
+            disp_layout_bands(s->band_layout, nb, band);
             r->band_weights = (unsigned)(4 * ntexels);
             for (int b = 0; b < nb; b++, ntexels++) {
                 float *t = texels + 4 * ntexels;
-                t[0] = w[b][0];
-                t[1] = w[b][1];
-                t[2] = w[b][2];
-                t[3] = (float)disp_band_centre(nb, b);
+                memcpy(t, band[b].rgb, sizeof band[b].rgb);
+                t[3] = (float)band[b].centre;
             }
             for (int i = 0; i < s->nmaterials; i++) {
                 if (mats[i].disp < 0) continue;
                 const DispModel *d = &s->materials[i].disp;
                 mats[i].disp = (int)(4 * ntexels);
                 for (int b = 0; b < nb; b++, ntexels++) {
-                    double lo, hi;
-                    disp_band_edges(nb, b, &lo, &hi);
                     float *t = texels + 4 * ntexels;
-                    t[0] = (float)disp_eta(d, 0.5 * (lo + hi));
-                    t[1] = (float)disp_band_transmit(d, lo, hi);
+                    t[0] = (float)disp_eta(d, band[b].centre);
+                    t[1] = (float)disp_band_transmit(d, band[b].lo, band[b].hi);
                     t[2] = t[3] = 0.0f;
                 }
             }
@@ -256,12 +252,17 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     if (r->features & VBCL_FEATURE_TRANSPARENCY) {
         r->k_tree = clCreateKernel(r->program, "tree_trace_secondary", &rc);
         CL_CHECK_ERR(rc, "clCreateKernel(tree_trace_secondary)", fail);
+        if (r->features & VBCL_FEATURE_DISPERSION) {
+            r->k_bands = clCreateKernel(r->program, "tree_trace_bands", &rc);
+            CL_CHECK_ERR(rc, "clCreateKernel(tree_trace_bands)", fail);
+        }
     }
 
     r->local_size = dev->max_wg >= 64 ? 64 : 0;
     renderer_fit_local_size(r, r->k_intersect);
     renderer_fit_local_size(r, r->k_shading);
     renderer_fit_local_size(r, r->k_tree);
+    renderer_fit_local_size(r, r->k_bands);
 
     double t0 = clu_now_ms();
     VbTriangle *tris = pack_triangles(s);
@@ -371,6 +372,10 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     r->media = clu_buffer(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
     r->counters = clu_buffer(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
     if (!r->frame || !r->rays || !r->hits || !r->radiance || !r->media || !r->counters) goto fail;
+    if (r->k_bands) {
+        r->splits = clu_buffer(dev, NULL, sizeof(VbSplitSet) * (size_t)cap, CL_MEM_READ_WRITE);
+        if (!r->splits) goto fail;
+    }
     st->upload_ms = clu_now_ms() - t0;
     st->tile_pixels = r->tile_pixels;
     return 0;
@@ -393,19 +398,23 @@ static void progress_report(double t_start, long done, long total, int *shown)
 int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
 {
     VbDevice *d = r->dev;
-    cl_event ev[3] = {0};
+    cl_event ev[4] = {0};
     cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
     size_t global = ((size_t)n + 63) / 64 * 64;
     int rc = -1;
     CL_CHECK(
         clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0, NULL, NULL),
         done);
-    /* first interfaces, local shading, and with dielectrics the ray trees */
-    cl_kernel stages[3] = {r->k_intersect, r->k_shading, r->k_tree};
-    for (int k = 0; k < 3; k++) {
+    /* first interfaces, local shading, with dielectrics the ray trees, and with dispersion
+     * the dispersive subtrees the trees left in r->splits */
+    cl_kernel stages[4] = {r->k_intersect, r->k_shading, r->k_tree, r->k_bands};
+    for (int k = 0; k < 4; k++) {
         if (!stages[k]) continue;
         if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
                                     r->counters))
+            goto done;
+        if (k >= 2 && r->k_bands &&
+            clu_set_arg(stages[k], RENDER_SCENE_ARGS + 6, sizeof(cl_mem), &r->splits))
             goto done;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global,
                                         renderer_local(r, global), 0, NULL, &ev[k]),
@@ -414,11 +423,13 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
     CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
                                  NULL),
              done);
-    double ms[3] = {clu_event_ms(ev[0]), clu_event_ms(ev[1]), ev[2] ? clu_event_ms(ev[2]) : 0.0};
+    double ms[4];
+    for (int k = 0; k < 4; k++) ms[k] = ev[k] ? clu_event_ms(ev[k]) : 0.0;
     st->intersect_ms += ms[0];
     st->shading_ms += ms[1];
     st->tree_ms += ms[2];
-    if (trace_ms) *trace_ms += ms[0] + ms[1] + ms[2];
+    st->dispersion_ms += ms[3];
+    if (trace_ms) *trace_ms += ms[0] + ms[1] + ms[2] + ms[3];
     st->rays_primary += (unsigned long long)n;
     st->rays_shadow += counts[VBCL_COUNT_SHADOW];
     st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
@@ -439,7 +450,7 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
         st->by_depth[k] += counts[VBCL_COUNT_DEPTH0 + k];
     rc = 0;
 done:
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 4; i++)
         if (ev[i]) clReleaseEvent(ev[i]);
     return rc;
 }
@@ -521,14 +532,15 @@ void renderer_release(Renderer *r)
     cl_mem *mems[] = {&r->tris,    &r->normals, &r->cell_start, &r->cell_tris, &r->materials,
                       &r->objects, &r->lights,  &r->patterns,   &r->texels,    &r->frame,
                       &r->rays,    &r->hits,    &r->media,      &r->radiance,  &r->counters,
-                      &r->aa_pass, &r->film,    &r->levels,     &r->marks,     &r->mark_counts};
+                      &r->aa_pass, &r->film,    &r->levels,     &r->marks,     &r->mark_counts,
+                      &r->splits};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) {
             CL_WARN(clReleaseMemObject(*mems[i]));
             *mems[i] = NULL;
         }
-    cl_kernel *ks[] = {&r->k_camera,      &r->k_intersect,   &r->k_shading,       &r->k_tree,
-                       &r->k_aa_generate, &r->k_aa_contrast, &r->k_aa_reconstruct};
+    cl_kernel *ks[] = {&r->k_camera, &r->k_intersect,   &r->k_shading,     &r->k_tree,
+                       &r->k_bands,  &r->k_aa_generate, &r->k_aa_contrast, &r->k_aa_reconstruct};
     for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++)
         if (*ks[i]) {
             CL_WARN(clReleaseKernel(*ks[i]));

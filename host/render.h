@@ -22,7 +22,8 @@ typedef struct RenderStats {
     int build_cached;
     double grid_ms, upload_ms;
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
-    double render_ms; /* wall time of the tile loop */
+    double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
+    double render_ms;     /* wall time of the tile loop */
     int tiles, tile_pixels;
     /* anti-aliasing (--aa: adaptive, --ssaa: uniform; host/aa.c) */
     int aa_rounds;                                          /* contrast passes that marked pixels */
@@ -37,9 +38,11 @@ typedef struct Renderer {
     VbDevice *dev;
     cl_program program;
     cl_kernel k_camera, k_intersect, k_shading, k_tree; /* k_tree: with transparency */
+    cl_kernel k_bands;                                  /* tree_trace_bands: with dispersion */
     cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels;
     cl_mem frame;
     cl_mem rays, hits, media, radiance, counters;
+    cl_mem splits; /* dispersion: one VbSplitSet per ray */
     /* anti-aliasing, created on first use (host/aa.c) */
     cl_kernel k_aa_generate, k_aa_contrast, k_aa_reconstruct;
     cl_mem aa_pass, film, levels, marks, mark_counts;

@@ -24,6 +24,7 @@ typedef struct Ctx {
     const char *file;
     char *err;
     size_t errlen;
+    int animated; /* the document has an animation (anim_apply) */
 } Ctx;
 
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
@@ -320,6 +321,21 @@ static int load_camera(Ctx *c, const cJSON *j, Scene *s)
     return 0;
 }
 
+/* render.bands: 1..64, or "thesis" (the per-channel 1/2/3 scheme, DISP_THESIS_BANDS rays). */
+static int get_bands(Ctx *c, const cJSON *j, Scene *s)
+{
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, "bands");
+    if (cJSON_IsString(b)) {
+        if (strcmp(b->valuestring, "thesis") != 0)
+            return fail(c, "render.bands", "expected an integer 1..%d or \"thesis\", got \"%s\"",
+                        DISP_MAX_BANDS, b->valuestring);
+        s->bands = DISP_THESIS_BANDS;
+        s->band_layout = DISP_LAYOUT_THESIS;
+        return 0;
+    }
+    return get_int(c, j, "render", "bands", 1, DISP_MAX_BANDS, 8, 0, &s->bands);
+}
+
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {
@@ -337,6 +353,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
     s->ssaa = 1;
     s->bands = 8;
+    s->band_layout = DISP_LAYOUT_UNIFORM;
     if (!j) return 0; /* absent: all defaults */
     if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -350,7 +367,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
         get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
                 &s->aa_max_level) ||
-        get_int(c, j, "render", "bands", 1, DISP_MAX_BANDS, 8, 0, &s->bands))
+        get_bands(c, j, s))
         return -1;
     s->seed = (unsigned)seed;
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
@@ -491,12 +508,14 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
     return 0;
 }
 
-/* materials.NAME.dispersion: {"model": "cauchy", "abbe": V_d} (n_d = the material's eta),
+/* materials.NAME.dispersion: {"model": "thesis", "spread": Δη} (eta at 670 nm, thesis 3.5),
+ * {"model": "cauchy", "abbe": V_d} (n_d = the material's eta),
  * {"model": "sellmeier", "preset": "BK7" | "F2"} or {"model": "sellmeier", "B": [3], "C": [3]},
  * each with an optional absorption band "band": [lo, hi] (nm) and "jump" (Δη beyond it). */
 static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta, DispModel *d)
 {
-    static const char *const keys[] = {"model", "abbe", "preset", "B", "C", "band", "jump", NULL};
+    static const char *const keys[] = {"model", "abbe", "preset", "B", "C",
+                                       "band",  "jump", "spread", NULL};
     memset(d, 0, sizeof *d);
     const cJSON *j = cJSON_GetObjectItemCaseSensitive(mat, "dispersion");
     if (!j) return 0;
@@ -505,8 +524,13 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
     if (expect_object(c, j, p) || check_keys(c, j, p, keys)) return -1;
     const cJSON *model = cJSON_GetObjectItemCaseSensitive(j, "model");
     path_key(q, p, "model");
-    if (!cJSON_IsString(model)) return fail(c, q, "expected \"cauchy\" or \"sellmeier\"");
-    if (strcmp(model->valuestring, "cauchy") == 0) {
+    if (!cJSON_IsString(model))
+        return fail(c, q, "expected \"thesis\", \"cauchy\" or \"sellmeier\"");
+    if (strcmp(model->valuestring, "thesis") == 0) {
+        double spread;
+        if (get_num(c, j, p, "spread", 0, 1, 0.03, 0, &spread)) return -1;
+        disp_thesis_model(d, eta, spread);
+    } else if (strcmp(model->valuestring, "cauchy") == 0) {
         double abbe;
         if (get_num(c, j, p, "abbe", 1, 200, 0, 1, &abbe)) return -1;
         disp_cauchy_from_abbe(d, eta, abbe);
@@ -528,7 +552,8 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
             }
         }
     } else {
-        return fail(c, q, "expected \"cauchy\" or \"sellmeier\", got \"%s\"", model->valuestring);
+        return fail(c, q, "expected \"thesis\", \"cauchy\" or \"sellmeier\", got \"%s\"",
+                    model->valuestring);
     }
     if (cJSON_GetObjectItemCaseSensitive(j, "band")) {
         float band[2], jump;
@@ -543,6 +568,23 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
         d->jump = jump;
     }
     return 0;
+}
+
+/* Without render.bands, a scene whose dispersive materials all use the thesis model
+ * renders with the thesis's per-channel rays. */
+static void default_band_layout(const cJSON *render, Scene *s)
+{
+    if (render && cJSON_GetObjectItemCaseSensitive(render, "bands")) return;
+    int thesis = 0, other = 0;
+    for (int i = 0; i < s->nmaterials; i++) {
+        int m = s->materials[i].disp.model;
+        thesis += m == DISP_THESIS;
+        other += m != DISP_THESIS && m != DISP_NONE;
+    }
+    if (thesis && !other) {
+        s->bands = DISP_THESIS_BANDS;
+        s->band_layout = DISP_LAYOUT_THESIS;
+    }
 }
 
 static int load_materials(Ctx *c, const cJSON *j, Scene *s)
@@ -1071,11 +1113,208 @@ void scene_medium_at(const Scene *s, vec3 p, VbMedium *m)
     }
 }
 
+/* ---- animation: tracks that set numbers of the scene document per frame ---- */
+
+/* The value a track's key holds: a number, or an array of up to 16 numbers. */
+typedef struct AnimValue {
+    int n; /* 0: a number; else the array's length */
+    double v[16];
+} AnimValue;
+
+static int anim_value(Ctx *c, const cJSON *j, const char *path, AnimValue *out)
+{
+    if (cJSON_IsNumber(j)) {
+        out->n = 0;
+        out->v[0] = j->valuedouble;
+        return 0;
+    }
+    int n = cJSON_IsArray(j) ? cJSON_GetArraySize(j) : 0;
+    if (n < 1 || n > 16)
+        return fail(c, path, "expected a number or an array of 1 to 16 numbers, got %s",
+                    json_type_name(j));
+    out->n = n;
+    for (int i = 0; i < n; i++) {
+        const cJSON *e = cJSON_GetArrayItem(j, i);
+        if (!cJSON_IsNumber(e)) return fail(c, path, "element %d is not a number", i);
+        out->v[i] = e->valuedouble;
+    }
+    return 0;
+}
+
+/* Sets the member a track's target names, "materials.glass.eta" or "objects.ball.transform.
+ * rotate", to val (taken over; NULL only checks the path): object members by key, array
+ * elements by index or by their "name". A missing last member is created (a setting left at
+ * its default), and so are missing objects on the way inside an element of an array (an
+ * object's transform); anything else must exist. */
+static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val)
+{
+    char buf[PATH_MAX_LEN];
+    if (strlen(target) >= sizeof buf || !*target) {
+        cJSON_Delete(val);
+        return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+    }
+    strcpy(buf, target);
+    cJSON *node = root;
+    char *save = NULL;
+    int in_element = 0; /* below an element of an array (an object, a light) */
+    for (char *seg = strtok_r(buf, ".", &save); seg; seg = strtok_r(NULL, ".", &save)) {
+        int last = *save == 0;
+        if (node == root && (strcmp(seg, "animation") == 0 || last)) {
+            cJSON_Delete(val);
+            return fail(c, path,
+                        "\"%s\": expected a value inside image, camera, render, lights, "
+                        "materials or objects",
+                        target);
+        }
+        int index = -1;
+        cJSON *next = NULL;
+        if (cJSON_IsArray(node)) {
+            char *end;
+            long i = strtol(seg, &end, 10);
+            int n = cJSON_GetArraySize(node);
+            if (*end == 0 && end != seg && i >= 0 && i < n) index = (int)i;
+            for (int k = 0; index < 0 && k < n; k++) {
+                const cJSON *nm =
+                    cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(node, k), "name");
+                if (cJSON_IsString(nm) && strcmp(nm->valuestring, seg) == 0) index = k;
+            }
+            if (index < 0) {
+                cJSON_Delete(val);
+                return fail(c, path, "\"%s\": no element \"%s\" (an index or a name)", target, seg);
+            }
+            next = cJSON_GetArrayItem(node, index);
+            in_element = 1;
+        } else if (cJSON_IsObject(node)) {
+            next = cJSON_GetObjectItemCaseSensitive(node, seg);
+            if (!next && node == root) {
+                cJSON_Delete(val);
+                return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+            }
+        } else {
+            cJSON_Delete(val);
+            return fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array", target,
+                        seg, json_type_name(node));
+        }
+        if (last) {
+            if (next && !cJSON_IsNumber(next) && !cJSON_IsArray(next)) {
+                cJSON_Delete(val);
+                return fail(c, path, "\"%s\" is a %s: only numbers and arrays of numbers animate",
+                            target, json_type_name(next));
+            }
+            if (!val) return 0;
+            cJSON_bool ok = index >= 0 ? cJSON_ReplaceItemInArray(node, index, val)
+                            : next     ? cJSON_ReplaceItemInObjectCaseSensitive(node, seg, val)
+                                       : cJSON_AddItemToObject(node, seg, val);
+            if (!ok) {
+                cJSON_Delete(val);
+                return fail(c, NULL, "out of memory");
+            }
+            return 0;
+        }
+        if (!next && !in_element) {
+            cJSON_Delete(val);
+            return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+        }
+        if (!next) {            /* a missing object on the way, inside an element (its transform) */
+            if (!val) return 0; /* checking only: it would be created */
+            next = cJSON_CreateObject();
+            if (!next || !cJSON_AddItemToObject(node, seg, next)) {
+                cJSON_Delete(next);
+                cJSON_Delete(val);
+                return fail(c, NULL, "out of memory");
+            }
+        }
+        node = next;
+    }
+    cJSON_Delete(val);
+    return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+}
+
+/* Applies root.animation for frame `frame`, linearly between the keys around it and holding
+ * the first and last keys beyond them (-1: checks the tracks, changes nothing), and returns
+ * the frame count in *frames (1 without an animation). */
+static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
+{
+    static const char *const keys[] = {"frames", "tracks", NULL};
+    static const char *const tkeys[] = {"target", "keys", NULL};
+    *frames = 1;
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(root, "animation");
+    if (!a) return 0;
+    if (expect_object(c, a, "animation") || check_keys(c, a, "animation", keys)) return -1;
+    const cJSON *fr = cJSON_GetObjectItemCaseSensitive(a, "frames");
+    if (!cJSON_IsNumber(fr) || fr->valuedouble != floor(fr->valuedouble) || fr->valuedouble < 1 ||
+        fr->valuedouble > 100000)
+        return fail(c, "animation.frames", "expected an integer 1 .. 100000");
+    *frames = (int)fr->valuedouble;
+    c->animated = 1;
+    const cJSON *tracks = cJSON_GetObjectItemCaseSensitive(a, "tracks");
+    if (!cJSON_IsArray(tracks) || cJSON_GetArraySize(tracks) < 1)
+        return fail(c, "animation.tracks", "expected an array of {\"target\", \"keys\"}");
+    for (int ti = 0; ti < cJSON_GetArraySize(tracks); ti++) {
+        const cJSON *t = cJSON_GetArrayItem(tracks, ti);
+        char p[PATH_MAX_LEN], q[PATH_MAX_LEN], kp[PATH_MAX_LEN];
+        path_index(p, "animation.tracks", ti);
+        if (expect_object(c, t, p) || check_keys(c, t, p, tkeys)) return -1;
+        const cJSON *target = cJSON_GetObjectItemCaseSensitive(t, "target");
+        const cJSON *ks = cJSON_GetObjectItemCaseSensitive(t, "keys");
+        path_key(q, p, "target");
+        if (!cJSON_IsString(target))
+            return fail(c, q, "expected a path such as \"materials.NAME.eta\"");
+        path_key(kp, p, "keys");
+        int nk = cJSON_IsArray(ks) ? cJSON_GetArraySize(ks) : 0;
+        if (nk < 1) return fail(c, kp, "expected [[frame, value], ...] with at least one key");
+        /* every key: [frame, value], frames increasing, values of one shape; and the pair of
+         * keys around the frame (lo, hi) */
+        AnimValue lo = {0}, hi = {0}, v;
+        double flo = 0, fhi = 0, prev = 0;
+        int found = 0;
+        for (int k = 0; k < nk; k++) {
+            const cJSON *key = cJSON_GetArrayItem(ks, k);
+            char ep[PATH_MAX_LEN];
+            path_index(ep, kp, k);
+            const cJSON *kf = cJSON_GetArrayItem(key, 0);
+            if (!cJSON_IsArray(key) || cJSON_GetArraySize(key) != 2 || !cJSON_IsNumber(kf))
+                return fail(c, ep, "expected [frame, value]");
+            if (anim_value(c, cJSON_GetArrayItem(key, 1), ep, &v)) return -1;
+            double f = kf->valuedouble;
+            if (k > 0 && v.n != lo.n)
+                return fail(c, ep, "the value has another shape than key 0's");
+            if (k > 0 && !(f > prev))
+                return fail(c, ep, "frames must increase (%g after %g)", f, prev);
+            prev = f;
+            if (k == 0 || (!found && f <= frame)) lo = v, flo = f; /* the last key at or before */
+            if (!found && (f >= frame || k == nk - 1)) {
+                hi = v, fhi = f; /* the first key at or after (or the last) */
+                found = 1;
+            }
+        }
+        if (fhi < flo || frame <= flo) hi = lo, fhi = flo; /* before the first key: hold it */
+        if (frame < 0) {
+            if (anim_set(c, root, target->valuestring, q, NULL)) return -1;
+            continue;
+        }
+        double w = fhi > flo ? (frame - flo) / (fhi - flo) : 0.0;
+        w = w < 0 ? 0 : w > 1 ? 1 : w;
+        double out[16];
+        int n = lo.n ? lo.n : 1;
+        for (int i = 0; i < n; i++) out[i] = lo.v[i] + w * (hi.v[i] - lo.v[i]);
+        cJSON *val = lo.n ? cJSON_CreateDoubleArray(out, lo.n) : cJSON_CreateNumber(out[0]);
+        if (!val) return fail(c, NULL, "out of memory");
+        if (anim_set(c, root, target->valuestring, q, val)) return -1;
+    }
+    return 0;
+}
+
 int scene_load(const char *path, Scene *s, char *err, size_t errlen)
 {
-    static const char *const keys[] = {"description", "image",     "camera",  "render",
-                                       "lights",      "materials", "objects", NULL};
-    Ctx c = {path, err, errlen};
+    return scene_load_frame(path, -1, s, err, errlen);
+}
+
+int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"description", "image",   "camera",    "render", "lights",
+                                       "materials",   "objects", "animation", NULL};
+    Ctx c = {path, err, errlen, 0};
     memset(s, 0, sizeof *s);
     mesh_init(&s->mesh);
     char *text = NULL;
@@ -1106,7 +1345,15 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen)
             snprintf(err, errlen, "%s:%d:%d: JSON syntax error near \"%s\"", path, line, col, near);
         goto fail;
     }
-    if (expect_object(&c, root, "") || check_keys(&c, root, "", keys)) goto fail;
+    if (expect_object(&c, root, "") || check_keys(&c, root, "", keys) ||
+        anim_apply(&c, root, frame, &s->frames))
+        goto fail;
+    if (frame >= s->frames) {
+        fail(&c, "animation.frames", "frame %d asked for, the scene has %d", frame, s->frames);
+        goto fail;
+    }
+    s->frame = frame < 0 ? 0 : frame;
+    s->animated = c.animated;
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     if (!cam) {
         fail(&c, "camera", "missing (expected an object with eye and look_at)");
@@ -1129,6 +1376,7 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen)
         load_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
         load_objects(&c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
         goto fail;
+    default_band_layout(cJSON_GetObjectItemCaseSensitive(root, "render"), s);
     cJSON_Delete(root);
     free(text);
     return 0;

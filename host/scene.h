@@ -70,6 +70,11 @@ typedef struct Scene {
     int aa_max_level;   /* deepest refinement level: 2^level x 2^level samples (1..4) */
     int ssaa;           /* uniform N x N supersampling (command line only); 1: off */
     int bands;          /* render.bands: wavelength bands of a dispersive split */
+    int band_layout;    /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
+                         * dispersive material uses the thesis model */
+    int frames;         /* animation.frames, or 1 */
+    int animated;       /* the scene has an "animation" */
+    int frame;          /* the frame loaded (0 for a scene as written) */
     /* contents */
     int nlights;
     VbLight *lights;
@@ -92,6 +97,12 @@ extern SceneTexgenFn scene_texgen;
  * err: "FILE:LINE:COL: ..." for JSON syntax, "FILE: json.path: what was expected" for
  * meaning, and the mesh file's own message for a bad mesh. On error *s is freed. */
 int scene_load(const char *path, Scene *s, char *err, size_t errlen);
+
+/* The same for frame `frame` of an animated scene (docs/scene-format.md, "animation"): the
+ * tracks set their targets for that frame before the scene is read. frame -1: the scene as
+ * written, tracks only checked. s->frames tells how many frames the scene has (1 if it is
+ * not animated); a frame beyond them is an error. */
+int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t errlen);
 
 /* Frees everything scene_load allocated. */
 void scene_free(Scene *s);

@@ -47,6 +47,7 @@ typedef struct ShadePoint {
     uint key;        /* decorrelates this point's random jitter */
     VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
     float scale;     /* largest vertex coordinate of the triangle: sizes the ray offsets */
+    int band;        /* wavelength band of the ray that found it, or -1: white */
 } ShadePoint;
 
 /* What a shadow feeler from sp lets through toward a light at distance t: 0 or 1, or,
@@ -55,7 +56,7 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 o
                               float t, TraceCount *tc)
 {
 #ifdef VBCL_HAS_TRANSPARENCY
-    return medium_shadow_transmittance(sc, origin, w, t, sp->medium, tc);
+    return medium_shadow_transmittance(sc, origin, w, t, sp->medium, sp->band, tc);
 #else
     (void)sp;
     return scene_trace_any(sc, origin, w, t, tc) ? (float3)(0.0f) : (float3)(1.0f);

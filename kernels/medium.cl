@@ -101,12 +101,55 @@ VB_INLINE int medium_trace(const DevScene *sc, float3 org, float3 dir, float tma
     return 0;
 }
 
-/* Light a shadow feeler carries from the point to a light at distance tmax, starting in
- * medium `state`: multiplied by the transmitted fraction of every interface it crosses
- * (weighted by that surface's k_global) and by absorption along the way; zero at an
- * opaque surface. Feelers are not bent. */
+#ifdef VBCL_HAS_DISPERSION
+/* A material's index in band b (its constant eta for white rays or without dispersion). */
+VB_INLINE float medium_eta(const DevScene *sc, uint m, int band)
+{
+    int d = sc->materials[m].disp;
+    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band] : sc->materials[m].eta;
+}
+
+/* Fraction of band b that material m lets in (its absorption band takes the rest). */
+VB_INLINE float medium_band_transmit(const DevScene *sc, uint m, int band)
+{
+    int d = sc->materials[m].disp;
+    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band + 1] : 1.0f;
+}
+#endif
+
+/* The fraction of light of band `band` (-1: white) that crosses the interface from
+ * material mb into ma along d, per channel. White light crossing into or out of a
+ * dispersive material is the band-weighted sum over the bands, each with its own index and
+ * with what the entered material's absorption band lets through. */
+VB_INLINE float3 medium_interface_transmit(const DevScene *sc, float3 d, float3 ng, uint mb,
+                                           uint ma, int band)
+{
+#ifdef VBCL_HAS_DISPERSION
+    if (band >= 0)
+        return (float3)(optics_transmitted_fraction(d, ng, medium_eta(sc, mb, band),
+                                                    medium_eta(sc, ma, band)) *
+                        medium_band_transmit(sc, ma, band));
+    if (sc->materials[mb].disp >= 0 || sc->materials[ma].disp >= 0) {
+        float3 t = (float3)(0.0f);
+        for (int b = 0; b < sc->f->bands; b++)
+            t += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) *
+                 (optics_transmitted_fraction(d, ng, medium_eta(sc, mb, b), medium_eta(sc, ma, b)) *
+                  medium_band_transmit(sc, ma, b));
+        return t;
+    }
+#else
+    (void)band;
+#endif
+    return (
+        float3)(optics_transmitted_fraction(d, ng, sc->materials[mb].eta, sc->materials[ma].eta));
+}
+
+/* Light a shadow feeler of band `band` (-1: white) carries from the point to a light at
+ * distance tmax, starting in medium `state`: multiplied by the transmitted fraction of
+ * every interface it crosses (weighted by that surface's k_global) and by absorption along
+ * the way; zero at an opaque surface. Feelers are not bent. */
 VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, float3 org, float3 dir, float tmax,
-                                             VbMedium state, TraceCount *tc)
+                                             VbMedium state, int band, TraceCount *tc)
 {
     float3 trans = (float3)(1.0f);
     float3 o = org;
@@ -123,9 +166,8 @@ VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, float3 org, flo
         if (c.interface) {
             __global const VbMaterial *ms = sc->materials + c.surface;
             if (ms->k_global <= 0.0f) return (float3)(0.0f);
-            trans *=
-                ms->k_global * optics_transmitted_fraction(dir, ng, sc->materials[c.mat_before].eta,
-                                                           sc->materials[c.mat_after].eta);
+            trans *= ms->k_global *
+                     medium_interface_transmit(sc, dir, ng, c.mat_before, c.mat_after, band);
         }
         if (vb_max3(trans) < 1e-7f) return (float3)(0.0f); /* nothing gets through */
         state = c.after;

@@ -30,18 +30,10 @@ __kernel void probe_intersect_brute(__global const VbTriangle *tris, uint ntris,
 __kernel void probe_layout(__global uint *out)
 {
     if (get_global_id(0) != 0) return;
-    out[0] = sizeof(VbRay);
-    out[1] = sizeof(VbHit);
-    out[2] = sizeof(VbTriangle);
-    out[3] = sizeof(VbMaterial);
-    out[4] = sizeof(VbLight);
-    out[5] = sizeof(VbFrame);
-    out[6] = VBCL_OFFSETOF(VbFrame, background);
-    out[7] = VBCL_OFFSETOF(VbFrame, seed);
-    out[8] = VBCL_OFFSETOF(VbMaterial, eta);
-    out[9] = VBCL_OFFSETOF(VbLight, radiance);
-    out[10] = sizeof(VbAaPass);
-    out[11] = VBCL_OFFSETOF(VbAaPass, seg_offset);
+    uint k = 0;
+#define PROBE_LAYOUT_ITEM(e) out[k++] = (uint)(e);
+    VBCL_LAYOUT_ITEMS(PROBE_LAYOUT_ITEM)
+#undef PROBE_LAYOUT_ITEM
 }
 
 /* The scene arguments every frame kernel starts with, for probes that shade. */
@@ -52,8 +44,9 @@ __kernel void probe_layout(__global uint *out)
         __global const VbObject *objects, __global const VbLight *lights,                          \
         __global const VbPattern *patterns, __global const float *texels
 
-/* points (xyz + unused), normals -> radiance: local shading of material 0 at given points
- * with given normals, seen from along the normal, in the camera's medium. */
+/* points (xyz + unused), normals (xyz + band + 1: 0 for white) -> radiance: local shading of
+ * material 0 at given points with given normals, seen from along the normal, in the
+ * camera's medium, by a ray of the given wavelength band. */
 __kernel void probe_shade_points(PROBE_SCENE_ARGS, __global const float *points,
                                  __global const float *pnormals, int npoints,
                                  __global float *radiance)
@@ -70,6 +63,7 @@ __kernel void probe_shade_points(PROBE_SCENE_ARGS, __global const float *points,
     sp.key = vb_hash((uint)i);
     sp.medium = f->camera_medium;
     sp.scale = 0.0f;
+    sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
     ShadowCount sc2 = {0, 0};
     float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
@@ -138,7 +132,7 @@ __kernel void probe_tree_exits(PROBE_SCENE_ARGS, __global const float *ray, int 
         TreeRay stack[VB_TREE_STACK];
         int n = 0;
         ShadePoint sp = shade_point_make(&sc, dir, ph.hit, 1u, state, ph.cx.surface);
-        tree_spawn(&sc, stack, &n, &sp, dir, &ph.cx, state, (float3)(1.0f), 1, &cnt, -1);
+        tree_spawn(&sc, stack, &n, &sp, dir, &ph.cx, state, (float3)(1.0f), 1, &cnt, -1, 0);
         while (n > 0) {
             TreeRay tr = stack[--n];
             VbMedium st = tr.medium;
@@ -153,7 +147,7 @@ __kernel void probe_tree_exits(PROBE_SCENE_ARGS, __global const float *ray, int 
             ShadePoint q = shade_point_make(&sc, tr.dir, ph.hit, tr.key, st, ph.cx.surface);
             if (materials[ph.cx.surface].k_global > 0.0f)
                 tree_spawn(&sc, stack, &n, &q, tr.dir, &ph.cx, st, tr.weight, tr.depth + 1, &cnt,
-                           tr.band);
+                           tr.band, 0);
         }
     }
     *count = k;

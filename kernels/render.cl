@@ -5,11 +5,14 @@
  *   scene_intersect_closest rays               -> hits, media (first interface of each ray)
  *   light_sample_shading    rays, hits, media  -> radiance (k_local term, shadow feelers)
  *   tree_trace_secondary    rays, hits, media  -> radiance += (k_global term: the ray tree;
- *                                                 only with VBCL_HAS_TRANSPARENCY)
+ *                                                 only with VBCL_HAS_TRANSPARENCY), splits
+ *   tree_trace_bands        splits             -> radiance += the recorded dispersive
+ *                                                 subtrees (only with VBCL_HAS_DISPERSION)
  *   aa_contrast_mark        film, levels       -> marks (pixels to refine; whole image)
  *   aa_reconstruct          radiance, marks    -> film, levels (box window per pixel)
  * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
- * adds the pass and the list, the other aa_* kernels take only their own buffers), are
+ * adds the pass and the list, with dispersion the tree kernels add the split records, the
+ * other aa_* kernels take only their own buffers), are
  * thin — index, bounds guard, device functions — and the host concatenates these files. */
 
 #include "types.h"
@@ -89,6 +92,7 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     sp.key = key;
     sp.medium = medium;
     sp.scale = TRI_SCALE(sc->tris, h.tri);
+    sp.band = -1;
     return sp;
 }
 
@@ -178,12 +182,79 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 }
 
 #ifdef VBCL_HAS_TRANSPARENCY
+#ifdef VBCL_HAS_DISPERSION
+#define TREE_SPLIT_ARG , __global VbSplitSet *splits
+#else
+#define TREE_SPLIT_ARG
+#endif
+
+/* Traces the pending branches on the stack, depth first, until it is empty; returns the
+ * radiance they carry to the sample. White rays that split record it in rec (may be 0). */
+VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, TreeCount *cnt, TraceCount *tc,
+                          ShadowCount *shc, __global VbSplitSet *rec)
+{
+    __constant const VbFrame *f = sc->f;
+    float3 acc = (float3)(0.0f);
+    while (n > 0) {
+        TreeRay tr = stack[--n];
+        VbMedium state = tr.medium;
+        PathHit ph;
+        if (!medium_trace(sc, tr.org, tr.dir, INFINITY, &state, &ph, tc, &cnt->passes)) {
+            acc += tr.weight * vb_cload3(f->background) *
+                   medium_absorb(sc, medium_material(sc, state), INFINITY);
+            continue;
+        }
+        float3 w = tr.weight * medium_absorb(sc, ph.cx.mat_before, ph.dist);
+        ShadePoint q = shade_point_make(sc, tr.dir, ph.hit, tr.key, state, ph.cx.surface);
+        q.band = tr.band;
+        __global const VbMaterial *ms = sc->materials + ph.cx.surface;
+        if (ms->k_local > 0.0f) acc += w * light_shade_local(sc, &q, tc, shc);
+        if (ms->k_global > 0.0f)
+            tree_spawn(sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, cnt, tr.band,
+                       rec);
+    }
+    return acc;
+}
+
+/* Adds one work item's tree counts to the frame counters. */
+VB_INLINE void tree_flush_counts(__global uint *counters, const TreeCount *cnt,
+                                 const TraceCount *tc, const ShadowCount *shc)
+{
+    atomic_add(&counters[VBCL_COUNT_REFLECTED], cnt->reflected);
+    atomic_add(&counters[VBCL_COUNT_TRANSMITTED], cnt->transmitted);
+    atomic_add(&counters[VBCL_COUNT_PRUNED], cnt->pruned);
+    atomic_add(&counters[VBCL_COUNT_DEPTH_CUT], cnt->depth_cut);
+    atomic_add(&counters[VBCL_COUNT_TIR], cnt->tir);
+    atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], cnt->passes);
+    atomic_add(&counters[VBCL_COUNT_INTERFACES], cnt->interfaces);
+    atomic_add(&counters[VBCL_COUNT_ENERGY_ERRORS], cnt->energy_errors);
+#ifdef VBCL_HAS_DISPERSION
+    if (cnt->splits) atomic_add(&counters[VBCL_COUNT_SPLITS], cnt->splits);
+    if (cnt->band_rays) atomic_add(&counters[VBCL_COUNT_BAND_RAYS], cnt->band_rays);
+#endif
+    for (int d = 1; d < VBCL_COUNT_DEPTH_BINS; d++)
+        if (cnt->by_depth[d]) atomic_add(&counters[VBCL_COUNT_DEPTH0 + d], cnt->by_depth[d]);
+    atomic_add(&counters[VBCL_COUNT_SHADOW], shc->traced);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc->skipped);
+    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc->steps);
+    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc->tests);
+}
+
 /* rays, hits, media -> radiance += the k_global term: the reflected and transmitted
- * subtree below each primary hit on a dielectric, with its own shadow feelers. */
-__kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
+ * subtree below each primary hit on a dielectric, with its own shadow feelers. With
+ * dispersion, the first VBCL_SPLIT_SLOTS splits of each tree are left in splits for
+ * tree_trace_bands, with the pruning budget that is left. */
+__kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
+#ifdef VBCL_HAS_DISPERSION
+    __global VbSplitSet *rec = splits + i;
+    rec->count = 0;
+    rec->budget = 0.0f;
+#else
+    __global VbSplitSet *rec = 0;
+#endif
     VbHit h = hits[i];
     if (h.tri < 0) return;
     DevScene sc = DEV_SCENE;
@@ -201,44 +272,53 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS)
     TraceCount tc = {0, 0};
     ShadowCount shc = {0, 0};
     tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
-               -1);
+               -1, rec);
+    float3 acc = tree_run(&sc, stack, n, &cnt, &tc, &shc, rec);
+    vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
+#ifdef VBCL_HAS_DISPERSION
+    rec->budget = cnt.prune_budget;
+#endif
+    tree_flush_counts(counters, &cnt, &tc, &shc);
+}
+
+#ifdef VBCL_HAS_DISPERSION
+/* splits -> radiance += the dispersive subtrees tree_trace_secondary recorded: for each
+ * recorded split its bands (tree_push_bands) and everything below them. Its own kernel, so
+ * that the time spent in dispersive subtrees is measured (--stats). */
+__kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    __global const VbSplitSet *rec = splits + i;
+    int count = rec->count;
+    if (count == 0) return;
+    DevScene sc = DEV_SCENE;
+    TreeRay stack[VB_TREE_STACK];
+    TreeCount cnt = {0};
+    cnt.prune_budget = rec->budget;
+    TraceCount tc = {0, 0};
+    ShadowCount shc = {0, 0};
     float3 acc = (float3)(0.0f);
-    while (n > 0) {
-        TreeRay tr = stack[--n];
-        VbMedium state = tr.medium;
-        PathHit ph;
-        if (!medium_trace(&sc, tr.org, tr.dir, INFINITY, &state, &ph, &tc, &cnt.passes)) {
-            acc += tr.weight * vb_cload3(f->background) *
-                   medium_absorb(&sc, medium_material(&sc, state), INFINITY);
-            continue;
-        }
-        float3 w = tr.weight * medium_absorb(&sc, ph.cx.mat_before, ph.dist);
-        ShadePoint q = shade_point_make(&sc, tr.dir, ph.hit, tr.key, state, ph.cx.surface);
-        __global const VbMaterial *ms = materials + ph.cx.surface;
-        if (ms->k_local > 0.0f) acc += w * light_shade_local(&sc, &q, &tc, &shc);
-        if (ms->k_global > 0.0f)
-            tree_spawn(&sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, &cnt, tr.band);
+    for (int k = 0; k < count; k++) {
+        VbSplit s = rec->s[k];
+        ShadePoint sp;
+        sp.p = vload3(0, s.p);
+        sp.scale = s.p[3];
+        sp.ng = vload3(0, s.ng);
+        sp.ns = vload3(0, s.ns);
+        Crossing c;
+        c.after = s.after;
+        c.mat_before = s.mat_before;
+        c.mat_after = s.mat_after;
+        int n = 0;
+        tree_push_bands(&sc, stack, &n, &sp, vload3(0, s.dir), &c, vload3(0, s.weight), s.depth,
+                        s.key, &cnt);
+        acc += tree_run(&sc, stack, n, &cnt, &tc, &shc, 0);
     }
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
-    atomic_add(&counters[VBCL_COUNT_REFLECTED], cnt.reflected);
-    atomic_add(&counters[VBCL_COUNT_TRANSMITTED], cnt.transmitted);
-    atomic_add(&counters[VBCL_COUNT_PRUNED], cnt.pruned);
-    atomic_add(&counters[VBCL_COUNT_DEPTH_CUT], cnt.depth_cut);
-    atomic_add(&counters[VBCL_COUNT_TIR], cnt.tir);
-    atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], cnt.passes);
-    atomic_add(&counters[VBCL_COUNT_INTERFACES], cnt.interfaces);
-    atomic_add(&counters[VBCL_COUNT_ENERGY_ERRORS], cnt.energy_errors);
-#ifdef VBCL_HAS_DISPERSION
-    if (cnt.splits) atomic_add(&counters[VBCL_COUNT_SPLITS], cnt.splits);
-    if (cnt.band_rays) atomic_add(&counters[VBCL_COUNT_BAND_RAYS], cnt.band_rays);
-#endif
-    for (int d = 1; d < VBCL_COUNT_DEPTH_BINS; d++)
-        if (cnt.by_depth[d]) atomic_add(&counters[VBCL_COUNT_DEPTH0 + d], cnt.by_depth[d]);
-    atomic_add(&counters[VBCL_COUNT_SHADOW], shc.traced);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc.skipped);
-    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc.steps);
-    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
+    tree_flush_counts(counters, &cnt, &tc, &shc);
 }
+#endif
 #endif
 
 /* frame, marks -> rays: side x side rays through the subpixel centres of each pixel of a

@@ -70,29 +70,56 @@ VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 
 }
 
 #ifdef VBCL_HAS_DISPERSION
-/* A material's index in band b (its constant eta for white rays or without dispersion). */
-VB_INLINE float tree_eta(const DevScene *sc, uint m, int band)
+/* Pushes the transmitted bands of a white ray that refracts at interface c (seen at sp,
+ * arriving along dir with weight wg, k_global included): one ray per band, weighted by the
+ * band's rgb weight, its own T and what the entered material lets through of the band. */
+VB_INLINE void tree_push_bands(const DevScene *sc, TreeRay *stack, int *n, const ShadePoint *sp,
+                               float3 dir, const Crossing *c, float3 wg, int depth, uint tkey,
+                               TreeCount *cnt)
 {
-    int d = sc->materials[m].disp;
-    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band] : sc->materials[m].eta;
+    for (int b = 0; b < sc->f->bands; b++) {
+        float3 bw = vb_gload3(sc->texels + sc->f->band_weights + 4 * b);
+        OpticsSplit s = optics_split(dir, sp->ns, sp->ng, medium_eta(sc, c->mat_before, b),
+                                     medium_eta(sc, c->mat_after, b));
+        cnt->tir += (uint)s.tir;
+        cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
+        if (s.T > 0.0f)
+            tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
+                      wg * bw * (s.T * medium_band_transmit(sc, c->mat_after, b)), c->after, depth,
+                      vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
+    }
 }
 
-/* Fraction of band b that material m lets in (its absorption band takes the rest). */
-VB_INLINE float tree_band_transmit(const DevScene *sc, uint m, int band)
+/* Records a split in the ray's next free slot for tree_trace_bands; 0 when the slots are
+ * full (the caller then pushes the bands itself). */
+VB_INLINE int tree_record_split(__global VbSplitSet *rec, const ShadePoint *sp, float3 dir,
+                                const Crossing *c, float3 wg, int depth, uint tkey)
 {
-    int d = sc->materials[m].disp;
-    return (band >= 0 && d >= 0) ? sc->texels[d + 4 * band + 1] : 1.0f;
+    if (!rec || rec->count >= VBCL_SPLIT_SLOTS) return 0;
+    __global VbSplit *s = rec->s + rec->count++;
+    vstore4((float4)(sp->p, sp->scale), 0, s->p);
+    vstore4((float4)(sp->ng, 0.0f), 0, s->ng);
+    vstore4((float4)(sp->ns, 0.0f), 0, s->ns);
+    vstore4((float4)(dir, 0.0f), 0, s->dir);
+    vstore4((float4)(wg, 0.0f), 0, s->weight);
+    s->after = c->after;
+    s->mat_before = c->mat_before;
+    s->mat_after = c->mat_after;
+    s->depth = depth;
+    s->key = tkey;
+    return 1;
 }
 #endif
 
 /* Pushes the children of a ray of band `band` (-1: white) that arrived along dir with
  * weight w at the interface c (seen at shading point sp, medium `before` on the incoming
  * side). A white ray refracting at an interface with a dispersive side splits: its
- * transmitted part becomes one ray per band, weighted by the band's rgb weight and its own
- * T; the reflected ray stays one white ray, weighted by the band-weighted sum of the R. */
+ * transmitted part becomes one ray per band (tree_push_bands), recorded in rec for
+ * tree_trace_bands while it has a free slot; the reflected ray stays one white ray,
+ * weighted by the band-weighted sum of the R. rec may be 0 (bands pushed here). */
 VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const ShadePoint *sp,
                           float3 dir, const Crossing *c, VbMedium before, float3 w, int depth,
-                          TreeCount *cnt, int band)
+                          TreeCount *cnt, int band, __global VbSplitSet *rec)
 {
     __global const VbMaterial *ms = sc->materials + c->surface;
     float3 wg = w * ms->k_global;
@@ -106,24 +133,15 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
             cnt->splits++;
             float3 wr = (float3)(0.0f);
             for (int b = 0; b < sc->f->bands; b++) {
-                OpticsSplit s = optics_split(dir, sp->ns, sp->ng, tree_eta(sc, c->mat_before, b),
-                                             tree_eta(sc, c->mat_after, b));
+                OpticsSplit s = optics_split(dir, sp->ns, sp->ng, medium_eta(sc, c->mat_before, b),
+                                             medium_eta(sc, c->mat_after, b));
                 wr += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) * s.R;
             }
             tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s0.reflected, wg * wr,
                       before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
             uint tkey = vb_hash(2u * sp->key + 2u);
-            for (int b = 0; b < sc->f->bands; b++) {
-                float3 bw = vb_gload3(sc->texels + sc->f->band_weights + 4 * b);
-                OpticsSplit s = optics_split(dir, sp->ns, sp->ng, tree_eta(sc, c->mat_before, b),
-                                             tree_eta(sc, c->mat_after, b));
-                cnt->tir += (uint)s.tir;
-                cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
-                if (s.T > 0.0f)
-                    tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
-                              wg * bw * (s.T * tree_band_transmit(sc, c->mat_after, b)), c->after,
-                              depth, vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
-            }
+            if (!tree_record_split(rec, sp, dir, c, wg, depth, tkey))
+                tree_push_bands(sc, stack, n, sp, dir, c, wg, depth, tkey, cnt);
             return;
         }
         cnt->tir += (uint)s0.tir;
@@ -131,9 +149,10 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
                   before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
         return;
     }
-    float eta1 = tree_eta(sc, c->mat_before, band), eta2 = tree_eta(sc, c->mat_after, band);
-    float tin = tree_band_transmit(sc, c->mat_after, band);
+    float eta1 = medium_eta(sc, c->mat_before, band), eta2 = medium_eta(sc, c->mat_after, band);
+    float tin = medium_band_transmit(sc, c->mat_after, band);
 #else
+    (void)rec;
     float eta1 = sc->materials[c->mat_before].eta, eta2 = sc->materials[c->mat_after].eta;
     float tin = 1.0f;
 #endif

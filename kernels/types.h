@@ -203,6 +203,55 @@ typedef struct VbFrame {
     float pad;
 } VbFrame;
 
+/* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
+ * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
+ * kernel's time). Each ray has VBCL_SPLIT_SLOTS records; further splits of the same tree are
+ * traced inline. Device data only: the host sizes the buffer. */
+#define VBCL_SPLIT_SLOTS 2
+typedef struct VbSplit {
+    float p[4];      /* the shading point; [3]: its triangle's scale (ray offsets) */
+    float ng[4];     /* unit geometric normal on the incoming side */
+    float ns[4];     /* unit shading normal, same side */
+    float dir[4];    /* incoming direction */
+    float weight[4]; /* weight arriving at the interface, times the surface's k_global */
+    VbMedium after;  /* the medium beyond the interface */
+    unsigned int mat_before, mat_after;
+    int depth;
+    unsigned int key; /* jitter key of the transmitted bands */
+    int pad[2];
+} VbSplit;
+
+typedef struct VbSplitSet {
+    VbSplit s[VBCL_SPLIT_SLOTS];
+    int count;    /* records in use */
+    float budget; /* pruning budget the first kernel left (see tree_push) */
+    int pad[2];
+} VbSplitSet;
+
+/* Every size and offset the host relies on, as one list that the host and the device both
+ * evaluate (probe_layout, test_kernel_struct_layout): the device compiler's layout must equal
+ * the host's, whatever the static asserts below say about either. */
+/* clang-format off */
+#define VBCL_LAYOUT_ITEMS(X)                                                                       \
+    X(sizeof(VbRay)) X(VBCL_OFFSETOF(VbRay, dir)) X(VBCL_OFFSETOF(VbRay, sample))                 \
+    X(sizeof(VbHit)) X(sizeof(VbTriangle)) X(sizeof(VbTriNormals)) X(sizeof(VbMaterial))          \
+    X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
+    X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
+    X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
+    X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
+    X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
+    X(VBCL_OFFSETOF(VbFrame, grid)) X(VBCL_OFFSETOF(VbFrame, background))                          \
+    X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
+    X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
+    X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, seg_offset)) X(sizeof(VbSplit))    \
+    X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
+    X(VBCL_OFFSETOF(VbSplitSet, count))
+/* clang-format on */
+#define VBCL_LAYOUT_COUNT_ONE(e) +1
+#define VBCL_LAYOUT_COUNT        (0 VBCL_LAYOUT_ITEMS(VBCL_LAYOUT_COUNT_ONE))
+
 VBCL_STATIC_ASSERT(sizeof(VbRay) == 32, ray_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbRay, dir) == 16, ray_dir);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbRay, sample) == 28, ray_sample);
@@ -233,6 +282,11 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, grid) == 64, frame_grid);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, background) == 144, frame_background);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, width) == 176, frame_width);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, seed) == 204, frame_seed);
+VBCL_STATIC_ASSERT(sizeof(VbSplit) == 112, split_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, after) == 80, split_after);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, key) == 100, split_key);
+VBCL_STATIC_ASSERT(sizeof(VbSplitSet) == 240, splitset_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplitSet, count) == 224, splitset_count);
 VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 64, aapass_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 32, aapass_first);

@@ -143,6 +143,62 @@ static void expect_bad(const char *scene_text, const char *extra_args, const cha
     CHECK(strcmp(buf, "previous image") == 0, "existing output untouched");
 }
 
+/* --frames renders numbered frames of an animated scene: a run of # in -o becomes the frame
+ * number; the frames differ as the animation says. */
+static void test_cli_frames(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file(
+        "anim_cli.json",
+        "{\"image\": {\"width\": 8, \"height\": 8},"
+        " \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+        " \"render\": {\"ambient\": [1, 1, 1]},"
+        " \"materials\": {\"m\": {\"ambient\": [0, 0, 0], \"diffuse\": [0, 0, 0]}},"
+        " \"objects\": [{\"shape\": \"quad\", \"size\": [20, 20], \"material\": \"m\","
+        "   \"transform\": {\"rotate\": [90, 0, 0]}}],"
+        " \"animation\": {\"frames\": 3, \"tracks\": [{\"target\": \"materials.m.ambient\","
+        "   \"keys\": [[0, [0, 0, 0]], [2, [0.5, 0.5, 0.5]]]}]}}");
+    char out[8192], args[2048], pattern[512], path[512];
+    snprintf(pattern, sizeof pattern, "%s/frame_###.exr", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s --frames 1:2", scene, pattern);
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 0, "--frames 1:2 exits 0 (%d): %s", rc, out);
+    for (int f = 0; f < 3; f++) {
+        snprintf(path, sizeof path, "%s/frame_%03d.exr", tu_tmpdir(), f);
+        CHECK(file_exists(path) == (f >= 1), "frame %d %s", f, f >= 1 ? "missing" : "written");
+        if (f == 0) continue;
+        float *px = NULL;
+        int w, h;
+        char err[512];
+        if (image_read(path, &w, &h, &px, err, sizeof err)) {
+            CHECK(0, "%s", err);
+            continue;
+        }
+        double want = 0.25 * f; /* ambient light 1 times the animated ambient colour */
+        CHECK(fabs(px[0] - want) < 1e-5, "frame %d: pixel %g, want %g", f, px[0], want);
+        free(px);
+    }
+    /* without #: _NNNN before the extension */
+    snprintf(args, sizeof args, "%s -o %s/anim.png --frames 2", scene, tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    snprintf(path, sizeof path, "%s/anim_0002.png", tu_tmpdir());
+    CHECK(rc == 0 && file_exists(path), "--frames 2 writes anim_0002.png: %s", out);
+    /* frames the scene does not have, and a scene without animation */
+    snprintf(args, sizeof args, "%s -o %s/x.png --frames 1:3", scene, tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "frames 0 to 2"), "--frames 1:3 of 3: %d %s", rc, out);
+    const char *plain = tu_write_file("plain_cli.json", GOOD_SCENE);
+    snprintf(args, sizeof args, "%s -o %s/x.png --frames 0", plain, tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "not animated"), "--frames on a still scene: %d %s", rc, out);
+    snprintf(args, sizeof args, "%s --frames 2:1", scene);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--frames"), "--frames 2:1: %d %s", rc, out);
+}
+
 static void test_cli_bad_input_classes(void)
 {
     expect_bad("{\"camera\": ", NULL, "bad.json:1:"); /* malformed JSON */
@@ -210,4 +266,5 @@ void suite_cli(void)
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);
+    RUN_TEST(test_cli_frames);
 }

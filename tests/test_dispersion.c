@@ -138,17 +138,17 @@ static void test_dispersion_scene_keys(void)
  * minimum deviation for n_d: runs the kernel's ray tree (probe_tree_exits) and returns, per
  * band, the exit angle (degrees, in the xy plane) of the band ray that went straight
  * through (depth 2), or NAN where none did. */
-static int prism_exits(const char *dispersion, int bands, double inc, double *angle,
-                       double *weight_sum)
+static int prism_exits(const char *dispersion, const char *bands_json, int bands, double inc,
+                       double *angle, double *weight_sum)
 {
     char json[2048];
     snprintf(json, sizeof json,
              "{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
-             " \"render\": {\"bands\": %d, \"max_depth\": 8},"
+             " \"render\": {\"bands\": %s, \"max_depth\": 8},"
              " \"materials\": {\"glass\": {\"k_local\": 0, \"k_global\": 1, \"eta\": 1.5168,"
              "   \"dispersion\": %s}},"
              " \"objects\": [{\"shape\": \"prism\", \"depth\": 1, \"material\": \"glass\"}]}",
-             bands, dispersion);
+             bands_json, dispersion);
     Fixture fx;
     if (fixture_open(&fx, json)) return -1;
     /* the left face runs from (-0.5, -0.2887) to (0, 0.5774); its inward normal is at -30°,
@@ -200,7 +200,7 @@ static void test_dispersion_prism_device(void)
     double angle[DISP_MAX_BANDS], ws[3], worst = 0;
     DispModel bk7 = {0};
     disp_sellmeier_preset(&bk7, "BK7");
-    int n = prism_exits("{\"model\": \"sellmeier\", \"preset\": \"BK7\"}", nb, inc, angle, ws);
+    int n = prism_exits("{\"model\": \"sellmeier\", \"preset\": \"BK7\"}", "8", nb, inc, angle, ws);
     CHECK(n > 0, "no rays left the prism");
     if (n <= 0) return;
     double prev = -1e9;
@@ -225,7 +225,7 @@ static void test_dispersion_prism_device(void)
      * are deviated more than those below it (thesis figure 3.4), and the bands inside it are
      * absorbed */
     n = prism_exits("{\"model\": \"cauchy\", \"abbe\": 60, \"band\": [500, 560], \"jump\": 0.04}",
-                    nb, inc, angle, ws);
+                    "8", nb, inc, angle, ws);
     CHECK(n > 0, "anomalous: no rays left");
     if (n <= 0) return;
     /* 8 bands of 50 nm: band 2 = 480-530 and band 3 = 530-580 overlap the absorption band */
@@ -287,6 +287,187 @@ done:
     for (int k = 0; k < 3; k++) free(img[k]);
 }
 
+/* The thesis's model and its per-channel rays (section 3.5): eta is the given value at
+ * 670 nm and rises by `spread` from 700 to 400 nm; the layout has 1 red, 2 green and 3 blue
+ * rays at equal steps of eta within each channel, summing to white. */
+static void test_dispersion_thesis_model_and_rays(void)
+{
+    DispModel m = {0};
+    disp_thesis_model(&m, 1.525, 0.03);
+    CHECK(fabs(disp_eta(&m, 670.0) - 1.525) < 1e-12, "eta(670) %.12f", disp_eta(&m, 670.0));
+    CHECK(fabs(disp_eta(&m, 400.0) - disp_eta(&m, 700.0) - 0.03) < 1e-12, "spread %.12f",
+          disp_eta(&m, 400.0) - disp_eta(&m, 700.0));
+    /* the 1/λ³ law the thesis states: dη/dλ ∝ λ⁻³ */
+    double k1 = (disp_eta(&m, 450.001) - disp_eta(&m, 449.999)) / 0.002 * pow(450.0, 3);
+    double k2 = (disp_eta(&m, 650.001) - disp_eta(&m, 649.999)) / 0.002 * pow(650.0, 3);
+    CHECK(fabs(k1 / k2 - 1.0) < 1e-5, "dη/dλ·λ³ at 450 and 650 nm: %g, %g", k1, k2);
+    DispBand b[DISP_MAX_BANDS];
+    int n = disp_layout_bands(DISP_LAYOUT_THESIS, 0, b);
+    CHECK(n == DISP_THESIS_BANDS && n == 6, "%d thesis rays", n);
+    int per[3] = {0, 0, 0};
+    double sum[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        int ch = -1;
+        for (int c = 0; c < 3; c++) {
+            sum[c] += b[i].rgb[c];
+            if (b[i].rgb[c] > 0) ch = c;
+        }
+        CHECK(ch >= 0, "ray %d carries no colour", i);
+        if (ch >= 0) per[ch]++;
+        CHECK(b[i].lo < b[i].centre && b[i].centre < b[i].hi, "ray %d: %g not in [%g, %g]", i,
+              b[i].centre, b[i].lo, b[i].hi);
+        CHECK(i == 0 || b[i].lo == b[i - 1].hi, "ray %d does not start where %d ends", i, i - 1);
+    }
+    CHECK(per[0] == 1 && per[1] == 2 && per[2] == 3, "rays per channel: red %d green %d blue %d",
+          per[0], per[1], per[2]);
+    CHECK(fabs(sum[0] - 1) < 1e-6 && fabs(sum[1] - 1) < 1e-6 && fabs(sum[2] - 1) < 1e-6,
+          "thesis rays sum to (%g, %g, %g)", sum[0], sum[1], sum[2]);
+    CHECK(b[5].centre == DISP_LAMBDA_LITHIUM, "the red ray at %g nm", b[5].centre);
+    /* equal steps of eta within a channel: blue rays 0..2 over 380–500, green 3..4 over
+     * 500–600; each ray's eta is the midpoint of its share of the channel's eta range */
+    double e_lo = disp_eta(&m, 500.0), e_hi = disp_eta(&m, DISP_LAMBDA_MIN);
+    for (int j = 0; j < 3; j++) {
+        double want = e_hi - (e_hi - e_lo) * (j + 0.5) / 3.0;
+        CHECK(fabs(disp_eta(&m, b[j].centre) - want) < 1e-12, "blue ray %d: eta %.9f, want %.9f", j,
+              disp_eta(&m, b[j].centre), want);
+    }
+    e_lo = disp_eta(&m, 600.0), e_hi = disp_eta(&m, 500.0);
+    for (int j = 0; j < 2; j++) {
+        double want = e_hi - (e_hi - e_lo) * (j + 0.5) / 2.0;
+        CHECK(fabs(disp_eta(&m, b[3 + j].centre) - want) < 1e-12,
+              "green ray %d: eta %.9f, want %.9f", j, disp_eta(&m, b[3 + j].centre), want);
+    }
+    /* the scene keys: "model": "thesis" alone selects the thesis rays; "bands" overrides */
+    const char *base = "{\"camera\":{\"eye\":[0,0,5],\"look_at\":[0,0,0]},%s"
+                       "\"materials\":{\"g\":{\"k_global\":1,\"eta\":1.5,\"dispersion\":"
+                       "{\"model\":\"thesis\"%s}}},"
+                       "\"objects\":[{\"shape\":\"sphere\",\"material\":\"g\"}]}";
+    const struct {
+        const char *render, *extra;
+        int bands, layout;
+    } cases[] = {{"", "", 6, DISP_LAYOUT_THESIS},
+                 {"\"render\":{\"bands\":16},", ",\"spread\":0.05", 16, DISP_LAYOUT_UNIFORM},
+                 {"\"render\":{\"bands\":\"thesis\"},", "", 6, DISP_LAYOUT_THESIS}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char json[1024], err[512];
+        snprintf(json, sizeof json, base, cases[i].render, cases[i].extra);
+        Scene s;
+        int rc = scene_load(tu_write_file("thesis.json", json), &s, err, sizeof err);
+        CHECK(rc == 0, "case %zu: %s", i, err);
+        if (rc) continue;
+        CHECK(s.bands == cases[i].bands && s.band_layout == cases[i].layout,
+              "case %zu: %d bands, layout %d", i, s.bands, s.band_layout);
+        CHECK(s.materials[0].disp.model == DISP_THESIS, "case %zu: model %d", i,
+              s.materials[0].disp.model);
+        scene_free(&s);
+    }
+}
+
+/* Through the kernel's ray tree, the thesis's six rays leave a 60° prism each at the Snell
+ * angle for its own index, within 0.01°: blue bent most, red (at the given eta) least. */
+static void test_dispersion_thesis_prism_device(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    DispModel m = {0};
+    disp_thesis_model(&m, 1.5168, 0.03);
+    DispBand b[DISP_MAX_BANDS];
+    int nb = disp_layout_bands(DISP_LAYOUT_THESIS, 0, b);
+    double inc = 0.5 * (disp_prism_min_deviation(1.5168, 60.0) + 60.0);
+    double angle[DISP_MAX_BANDS], ws[3], worst = 0, prev = -1e9;
+    int n =
+        prism_exits("{\"model\": \"thesis\", \"spread\": 0.03}", "\"thesis\"", nb, inc, angle, ws);
+    CHECK(n > 0, "no rays left the prism");
+    if (n <= 0) return;
+    for (int i = 0; i < nb; i++) {
+        double want = (inc - 30.0) - disp_prism_deviation(disp_eta(&m, b[i].centre), 60.0, inc);
+        CHECK(fabs(angle[i] - want) < 0.01, "ray %d (%.1f nm): exit %.4f°, Snell %.4f°", i,
+              b[i].centre, angle[i], want);
+        worst = fmax(worst, fabs(angle[i] - want));
+        CHECK(i == 0 || angle[i] > prev, "ray %d not deviated less than ray %d", i, i - 1);
+        prev = angle[i];
+    }
+    fprintf(stderr, "    thesis rays: deviation %.3f° (blue) .. %.3f° (red), worst error %.2e°\n",
+            (inc - 30.0) - angle[0], (inc - 30.0) - angle[nb - 1], worst);
+    for (int c = 0; c < 3; c++)
+        CHECK(ws[c] > 0.99 && ws[c] < 1.0 + 1e-4, "channel %d: %g of the energy left", c, ws[c]);
+}
+
+/* Shadow feelers through dispersive glass: a point behind a slab of glass with an absorption
+ * band, lit by a point light at normal incidence. A feeler of one band lets through that
+ * band's two Fresnel transmissions and what the absorption band leaves of it. A white feeler
+ * carries rgb, so at each interface it takes the band-weighted mean of the bands'
+ * transmissions: exact per interface, and within 1e-3 of the band-resolved sum over both. */
+static void test_dispersion_shadow_feelers(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    Fixture fx;
+    if (fixture_open(&fx,
+                     "{\"camera\": {\"eye\": [0, 0, 20], \"look_at\": [0, 0, 0]},"
+                     " \"render\": {\"shadow_samples\": 1, \"ambient\": [0, 0, 0], \"bands\": 8},"
+                     " \"lights\": [{\"centre\": [0, 0, 0], \"radius\": 0, \"intensity\": 1}],"
+                     " \"materials\": {\"m\": {\"diffuse\": [1, 1, 1]},"
+                     "   \"g\": {\"k_local\": 0, \"k_global\": 1, \"eta\": 1.6, \"dispersion\":"
+                     "     {\"model\": \"cauchy\", \"abbe\": 20, \"band\": [500, 560], "
+                     "\"jump\": 0.05}}},"
+                     " \"objects\": [{\"shape\": \"box\", \"size\": [0.2, 2, 2], "
+                     "\"material\": \"g\", \"transform\": {\"translate\": [1, 0, 0]}}]}"))
+        return;
+    DispModel g = {0};
+    disp_cauchy_from_abbe(&g, 1.6, 20.0);
+    g.has_band = 1, g.band_lo = 500, g.band_hi = 560, g.jump = 0.05;
+    DispBand b[DISP_MAX_BANDS];
+    int nb = disp_layout_bands(DISP_LAYOUT_UNIFORM, 8, b);
+    enum { N = 9 }; /* white, then each band */
+    float pts[N * 4], nrm[N * 4], out[N * 4];
+    for (int i = 0; i < N; i++) {
+        pts[4 * i] = 2.0f, pts[4 * i + 1] = pts[4 * i + 2] = pts[4 * i + 3] = 0;
+        nrm[4 * i] = -1.0f, nrm[4 * i + 1] = nrm[4 * i + 2] = 0, nrm[4 * i + 3] = (float)i;
+    }
+    cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
+           mo = buffer(NULL, sizeof out);
+    int n = N;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *v[] = {&mp, &mn, &n, &mo};
+    fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
+    read_buffer(mo, out, sizeof out);
+    const double unlit = 1.0 / (4.0 * M_PI); /* E = I / d², radiance E / π, d = 2 */
+    double white[3] = {0, 0, 0}, in[3] = {0, 0, 0}, outw[3] = {0, 0, 0};
+    for (int k = 0; k < nb; k++) {
+        double e = disp_eta(&g, b[k].centre), r = (e - 1) / (e + 1);
+        double tb = disp_band_transmit(&g, b[k].lo, b[k].hi);
+        double t = (1 - r * r) * (1 - r * r) * tb;
+        for (int c = 0; c < 3; c++) {
+            white[c] += b[k].rgb[c] * t;
+            in[c] += b[k].rgb[c] * (1 - r * r) * tb;
+            outw[c] += b[k].rgb[c] * (1 - r * r);
+        }
+        double got = out[4 * (k + 1)] / unlit;
+        CHECK(fabs(got - t) < 2e-5, "band %d feeler lets %.6f through, want %.6f", k, got, t);
+    }
+    for (int c = 0; c < 3; c++) {
+        double got = out[c] / unlit;
+        CHECK(fabs(got - in[c] * outw[c]) < 2e-5, "white feeler, channel %d: %.6f, want %.6f", c,
+              got, in[c] * outw[c]);
+        CHECK(fabs(got - white[c]) < 1e-3, "white feeler, channel %d: %.6f, band-resolved %.6f", c,
+              got, white[c]);
+    }
+    fprintf(stderr,
+            "    white feeler through the slab: (%.5f, %.5f, %.5f); band-resolved (%.5f, %.5f, "
+            "%.5f); base eta alone would give %.5f\n",
+            out[0] / unlit, out[1] / unlit, out[2] / unlit, white[0], white[1], white[2],
+            pow(1 - pow(0.6 / 2.6, 2), 2));
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mn);
+    clReleaseMemObject(mo);
+    fixture_close(&fx);
+}
+
 void suite_dispersion(void)
 {
     RUN_TEST(test_dispersion_models_match_catalogue);
@@ -295,4 +476,7 @@ void suite_dispersion(void)
     RUN_TEST(test_dispersion_scene_keys);
     RUN_TEST(test_dispersion_prism_device);
     RUN_TEST(test_dispersion_bands_leave_other_paths_alone);
+    RUN_TEST(test_dispersion_thesis_model_and_rays);
+    RUN_TEST(test_dispersion_thesis_prism_device);
+    RUN_TEST(test_dispersion_shadow_feelers);
 }

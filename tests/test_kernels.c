@@ -26,26 +26,19 @@ static void test_kernel_struct_layout(void)
             "{\"camera\": {\"eye\": [0,0,5], \"look_at\": [0,0,0]}, \"materials\": {\"m\": {}},"
             " \"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
         return;
-    cl_uint out[12] = {0};
+    enum { N = VBCL_LAYOUT_COUNT };
+    cl_uint out[N] = {0};
     cl_mem m = buffer(NULL, sizeof out);
     const size_t sz[] = {sizeof(cl_mem)};
     const void *v[] = {&m};
     run_kernel(fx.r.program, "probe_layout", 1, 1, sz, v);
     read_buffer(m, out, sizeof out);
-    const cl_uint want[12] = {sizeof(VbRay),
-                              sizeof(VbHit),
-                              sizeof(VbTriangle),
-                              sizeof(VbMaterial),
-                              sizeof(VbLight),
-                              sizeof(VbFrame),
-                              offsetof(VbFrame, background),
-                              offsetof(VbFrame, seed),
-                              offsetof(VbMaterial, eta),
-                              offsetof(VbLight, radiance),
-                              sizeof(VbAaPass),
-                              offsetof(VbAaPass, seg_offset)};
-    for (int i = 0; i < 12; i++)
+#define HOST_LAYOUT_ITEM(e) (cl_uint)(e),
+    const cl_uint want[N] = {VBCL_LAYOUT_ITEMS(HOST_LAYOUT_ITEM)};
+#undef HOST_LAYOUT_ITEM
+    for (int i = 0; i < N; i++)
         CHECK(out[i] == want[i], "layout item %d: device %u, host %u", i, out[i], want[i]);
+    CHECK(N >= 38, "only %d layout items", N);
     clReleaseMemObject(m);
     fixture_close(&fx);
 }

@@ -305,8 +305,101 @@ static void test_scene_examples_load(void)
     CHECK(n >= 10, "found the example scenes (%d)", n);
 }
 
+/* Animation: tracks interpolate numbers and arrays linearly between keys, hold the ends,
+ * find array elements by name or index, create missing transforms; bad tracks name their
+ * place. */
+static void test_scene_animation(void)
+{
+    static const char *anim =
+        "{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+        " \"materials\": {\"m\": {}, \"g\": {\"k_global\": 1, \"eta\": 3.7}},"
+        " \"objects\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"material\": \"g\"},"
+        "   {\"shape\": \"box\", \"material\": \"m\"}],"
+        " \"animation\": {\"frames\": 8, \"tracks\": ["
+        "   {\"target\": \"materials.g.eta\", \"keys\": [[0, 3.7], [7, 1.501]]},"
+        "   {\"target\": \"camera.eye\", \"keys\": [[2, [0, 0, 5]], [4, [4, 2, 5]], [6, [4, 2, "
+        "9]]]},"
+        "   {\"target\": \"objects.ball.transform.translate\", \"keys\": [[0, [0, 0, 0]], [7, "
+        "[7, 0, 0]]]},"
+        "   {\"target\": \"objects.1.transform.scale\", \"keys\": [[0, 1], [7, 2]]}]}}";
+    const char *path = tu_write_file("anim.json", anim);
+    /* frame, eta, eye x, eye y, eye z, ball's x */
+    const double want[][6] = {{0, 3.7, 0, 0, 5, 0},
+                              {3, 3.7 + 3.0 / 7.0 * (1.501 - 3.7), 2, 1, 5, 3},
+                              {5, 3.7 + 5.0 / 7.0 * (1.501 - 3.7), 4, 2, 7, 5},
+                              {7, 1.501, 4, 2, 9, 7}};
+    for (int k = 0; k < 4; k++) {
+        Scene s;
+        char err[1024] = "";
+        int f = (int)want[k][0];
+        int rc = scene_load_frame(path, f, &s, err, sizeof err);
+        CHECK(rc == 0, "frame %d: %s", f, err);
+        if (rc) continue;
+        CHECK(s.animated && s.frames == 8 && s.frame == f, "frame %d: animated %d, %d frames", f,
+              s.animated, s.frames);
+        CHECK(fabs(s.materials[1].gpu.eta - want[k][1]) < 1e-6, "frame %d: eta %.6f, want %.6f", f,
+              (double)s.materials[1].gpu.eta, want[k][1]);
+        CHECK(fabs(s.eye.x - want[k][2]) < 1e-6 && fabs(s.eye.y - want[k][3]) < 1e-6 &&
+                  fabs(s.eye.z - want[k][4]) < 1e-6,
+              "frame %d: eye (%g, %g, %g)", f, s.eye.x, s.eye.y, s.eye.z);
+        /* the ball (a unit sphere at the origin) moved along x: its bounds' centre */
+        double lo = 1e30, hi = -1e30;
+        for (unsigned t = s.objects[0].first_tri; t < s.objects[0].first_tri + s.objects[0].ntris;
+             t++)
+            for (int v = 0; v < 3; v++) {
+                double x = s.mesh.verts[s.mesh.tris[3 * t + v]].x;
+                lo = fmin(lo, x), hi = fmax(hi, x);
+            }
+        CHECK(fabs(0.5 * (lo + hi) - want[k][5]) < 1e-5, "frame %d: ball centred at x %g", f,
+              0.5 * (lo + hi));
+        scene_free(&s);
+    }
+    /* the scene as written: animated, frame 0's values not applied */
+    Scene s;
+    char err[1024] = "";
+    CHECK(scene_load(path, &s, err, sizeof err) == 0 && s.animated && s.frames == 8, "%s", err);
+    if (!err[0]) scene_free(&s);
+    CHECK(scene_load_frame(path, 8, &s, err, sizeof err) == 2 && strstr(err, "animation.frames"),
+          "frame 8 of 8: %s", err);
+    /* bad tracks */
+#define ANIM_BAD(tracks)                                                                           \
+    MIN_SCENE_HEAD " \"objects\": [{\"name\": \"b\", \"shape\": \"box\", \"material\": \"m\"}],"   \
+                   " \"animation\": {\"frames\": 4, \"tracks\": [" tracks "]}}"
+    expect_error(ANIM_BAD("{\"target\": \"materials.x.eta\", \"keys\": [[0, 1]]}"),
+                 "animation.tracks[0].target", "no member \"x\"");
+    expect_error(ANIM_BAD("{\"target\": \"objects.c.transform.scale\", \"keys\": [[0, 1]]}"),
+                 "animation.tracks[0].target", "no element \"c\"");
+    expect_error(ANIM_BAD("{\"target\": \"objects.b.shape\", \"keys\": [[0, 1]]}"),
+                 "animation.tracks[0].target", "only numbers");
+    expect_error(ANIM_BAD("{\"target\": \"camera.fov\", \"keys\": [[0, 30], [0, 40]]}"),
+                 "animation.tracks[0].keys[1]", "increase");
+    expect_error(ANIM_BAD("{\"target\": \"camera.eye\", \"keys\": [[0, [0, 0, 5]], [2, 4]]}"),
+                 "animation.tracks[0].keys[1]", "shape");
+    expect_error(ANIM_BAD("{\"target\": \"camera.fov\", \"keys\": [[0, \"wide\"]]}"),
+                 "animation.tracks[0].keys[0]", "number");
+    expect_error(ANIM_BAD("{\"target\": \"camera.fov\", \"keys\": []}"), "animation.tracks[0].keys",
+                 "at least one key");
+    expect_error(ANIM_BAD("{\"target\": \"animation.frames\", \"keys\": [[0, 1]]}"),
+                 "animation.tracks[0].target", "expected a value inside");
+    expect_error(ANIM_BAD("{\"target\": \"camera.fov\", \"keys\": [[0, 30]], \"ease\": 1}"),
+                 "animation.tracks[0].ease", "unknown key");
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [], \"animation\": {\"frames\": 2.5, \"tracks\": []}}",
+                 "animation.frames", "integer");
+    /* a value out of range in some frame: caught when that frame loads, with its path */
+    const char *hot = tu_write_file(
+        "anim_range.json",
+        ANIM_BAD("{\"target\": \"materials.m.k_global\", \"keys\": [[0, 0.5], [3, 2.5]]}"));
+    CHECK(scene_load_frame(hot, 0, &s, err, sizeof err) == 0, "frame 0: %s", err);
+    if (!err[0]) scene_free(&s);
+    CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 && strstr(err, "materials.m.k_global"),
+          "frame 3: %s", err);
+#undef ANIM_BAD
+}
+
 void suite_scene(void)
 {
+    RUN_TEST(test_scene_animation);
     RUN_TEST(test_scene_examples_load);
     RUN_TEST(test_scene_texture_generate_inline);
     RUN_TEST(test_scene_minimal_defaults);
