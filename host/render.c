@@ -348,6 +348,7 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_
     unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
     f->shadow_strata = strata < 1 ? 1 : strata;
     f->seed = s->seed;
+    f->flags = s->shadow_jitter ? 0u : VBCL_FRAME_FIXED_FEELERS;
     scene_medium_at(s, s->eye, &f->camera_medium);
     f->air_material = (unsigned)s->nmaterials;
     f->min_weight = s->min_weight;

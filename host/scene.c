@@ -339,8 +339,8 @@ static int get_bands(Ctx *c, const cJSON *j, Scene *s)
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {
-        "max_depth", "grid",       "grid_density", "shadow_samples", "ambient", "seed",
-        "fresnel",   "min_weight", "aa",           "aa_max_level",   "bands",   NULL};
+        "max_depth",  "grid", "grid_density", "shadow_samples", "ambient",       "seed", "fresnel",
+        "min_weight", "aa",   "aa_max_level", "bands",          "shadow_jitter", NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = GRID_DEFAULT_DENSITY;
@@ -354,6 +354,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->ssaa = 1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
+    s->shadow_jitter = 1;
     if (!j) return 0; /* absent: all defaults */
     if (expect_object(c, j, "render") || check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -370,6 +371,13 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_bands(c, j, s))
         return -1;
     s->seed = (unsigned)seed;
+    const cJSON *jit = cJSON_GetObjectItemCaseSensitive(j, "shadow_jitter");
+    if (jit) {
+        if (!cJSON_IsBool(jit))
+            return fail(c, "render.shadow_jitter", "expected true or false, got %s",
+                        json_type_name(jit));
+        s->shadow_jitter = cJSON_IsTrue(jit);
+    }
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
     if (fr) {
         if (cJSON_IsString(fr) && strcmp(fr->valuestring, "exact") == 0)

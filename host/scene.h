@@ -64,6 +64,7 @@ typedef struct Scene {
     int shadow_samples; /* as given; the kernels use the nearest square */
     float ambient[3];
     unsigned seed;
+    int shadow_jitter;  /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
     int fresnel;        /* SCENE_FRESNEL_* */
     float min_weight;   /* ray-tree pruning threshold */
     float aa_threshold; /* adaptive anti-aliasing contrast threshold; 0: off */

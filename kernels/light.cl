@@ -70,7 +70,8 @@ typedef struct ShadowCount {
 } ShadowCount;
 
 /* Reflected radiance toward wo from one light: the cap of the light sphere visible from
- * the point is sampled at strata^2 stratified directions; each direction's feeler is
+ * the point is sampled at strata^2 stratified directions (jittered inside their strata, or
+ * at the strata's centres with VBCL_FRAME_FIXED_FEELERS); each direction's feeler is
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
  * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
 VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *light,
@@ -92,6 +93,7 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
 #endif
     float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
     uint strata = scn->f->shadow_strata;
+    int jitter = !(scn->f->flags & VBCL_FRAME_FIXED_FEELERS);
 
 #ifdef VBCL_HAS_AREA_LIGHTS
     if (r > 0.0f) {
@@ -116,8 +118,8 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
         for (uint i = 0; i < strata; i++) {
             for (uint j = 0; j < strata; j++) {
                 uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
-                float u1 = ((float)i + vb_unit_float(h)) / (float)strata;
-                float u2 = ((float)j + vb_unit_float(vb_hash(h))) / (float)strata;
+                float u1 = ((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata;
+                float u2 = ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata;
                 float cos_t = 1.0f - u1 * one_minus_cos;
                 float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
                 float phi = 2.0f * VB_PI * u2;

@@ -200,8 +200,11 @@ typedef struct VbFrame {
     int bands;                 /* wavelength bands of a dispersive split */
     unsigned int band_weights; /* first float of the bands' rgb weights (4 floats each) in the
                                 * side data (texels) */
-    float pad;
+    unsigned int flags;        /* VBCL_FRAME_* */
 } VbFrame;
+
+/* VbFrame.flags */
+#define VBCL_FRAME_FIXED_FEELERS 1u /* shadow feelers at stratum centres, the same everywhere */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
  * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
@@ -244,7 +247,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, seg_offset)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))

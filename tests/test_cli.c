@@ -199,6 +199,46 @@ static void test_cli_frames(void)
     CHECK(rc == 2 && strstr(out, "--frames"), "--frames 2:1: %d %s", rc, out);
 }
 
+/* render.shadow_jitter false puts every feeler at its stratum's centre: two seeds give the
+ * same image; jittered feelers (the default) differ with the seed. */
+static void test_cli_fixed_feelers(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    float *img[4] = {NULL};
+    int w = 0, h = 0;
+    for (int k = 0; k < 4; k++) {
+        char text[2048], out[4096], args[2048], path[512], err[512];
+        snprintf(text, sizeof text,
+                 "{\"image\": {\"width\": 24, \"height\": 24},"
+                 " \"camera\": {\"eye\": [0, 1, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"seed\": %d, \"shadow_samples\": 4, \"shadow_jitter\": %s},"
+                 " \"lights\": [{\"centre\": [2, 4, 3], \"radius\": 1.5, \"flux\": 500}],"
+                 " \"materials\": {\"m\": {}},"
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},"
+                 "   {\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"m\","
+                 "    \"transform\": {\"translate\": [0, -1, 0]}}]}",
+                 1 + k % 2, k < 2 ? "false" : "true");
+        const char *scene = tu_write_file("jitter.json", text);
+        snprintf(path, sizeof path, "%s/jitter%d.exr", tu_tmpdir(), k);
+        snprintf(args, sizeof args, "%s -q -o %s", scene, path);
+        CHECK(vbcl(args, out, sizeof out) == 0, "render %d: %s", k, out);
+        if (image_read(path, &w, &h, &img[k], err, sizeof err)) CHECK(0, "%s", err);
+    }
+    if (img[0] && img[1] && img[2] && img[3]) {
+        double fixed = 0, jittered = 0;
+        for (int i = 0; i < w * h * 4; i++) {
+            fixed = fmax(fixed, fabs(img[0][i] - img[1][i]));
+            jittered = fmax(jittered, fabs(img[2][i] - img[3][i]));
+        }
+        CHECK(fixed == 0.0, "fixed feelers differ with the seed by %g", fixed);
+        CHECK(jittered > 1e-3, "jittered feelers do not depend on the seed (%g)", jittered);
+    }
+    for (int k = 0; k < 4; k++) free(img[k]);
+}
+
 static void test_cli_bad_input_classes(void)
 {
     expect_bad("{\"camera\": ", NULL, "bad.json:1:"); /* malformed JSON */
@@ -267,4 +307,5 @@ void suite_cli(void)
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);
     RUN_TEST(test_cli_frames);
+    RUN_TEST(test_cli_fixed_feelers);
 }
