@@ -103,13 +103,23 @@ run: vbcl
 # Runs every test (kernels on the default OpenCL device). Sanitizer builds run the tests
 # against their own instrumented vbcl.
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0)
+# Then every benchmark part on tiny images (scripts/bench.py --quick), so that `make bench`
+# cannot rot; not in sanitizer builds, whose timings mean nothing.
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
+ifeq ($(SANITIZE),)
+	$(Q)scripts/bench.py --quick --vbcl $(BUILD)/vbcl --out $(BUILD)/bench-quick > $(BUILD)/bench-quick.log 2>&1 \
+	  && echo "bench --quick: every part ran ($(BUILD)/bench-quick/bench.md)" \
+	  || { tail -30 $(BUILD)/bench-quick.log; echo "bench --quick FAILED"; exit 1; }
+endif
 
-# Anti-aliasing: render time against error for adaptive thresholds and uniform supersampling
-# (docs/architecture.md, "Measurements"); CSV and plot in bench-out/.
+# The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
+# figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
+# band counts, kernel build time. CSV, markdown and PNG in bench-out/. BENCH_FLAGS passes
+# options, e.g. BENCH_FLAGS="--parts grid --size 200".
+BENCH_FLAGS ?=
 bench: vbcl
-	scripts/bench_aa.py
+	scripts/bench.py $(BENCH_FLAGS)
 
 # Render time against the auto-grid density (docs/architecture.md, "Measurements").
 bench-grid: vbcl
@@ -131,6 +141,7 @@ oclgrind: $(BUILD)/vbcl
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny.json "$(OCLGRIND_FLAGS)"
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_aa.json "$(OCLGRIND_FLAGS)"
+	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_dispersion.json "$(OCLGRIND_FLAGS)" 1e-3
 
 # libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
 # run for FUZZ_SECONDS each from the seed corpus in tests/fuzz/corpus/ (docs/testing.md).

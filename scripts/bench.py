@@ -1,0 +1,387 @@
+#!/usr/bin/env python3
+"""bench.py — `make bench`: the thesis's own measurements and ours, in four parts.
+
+  1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
+              threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
+              dispersion time and the total, beside the thesis's 1995 figures;
+  2. grid     throughput (Mrays/s by ray kind) across grid sizes 5^3 .. 128^3 and auto on
+              scenes from about 100 to 184,000 triangles;
+  3. error    run time against error (RMSE and PSNR against a converged reference) for
+              anti-aliasing thresholds (scripts/bench_aa.py) and for band counts;
+  4. build    kernel build time, cold (empty binary cache) and warm, per feature set.
+
+usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build] [--vbcl ./vbcl]
+                        [--out bench-out] [--size N] [--repeats N]
+
+Writes OUT/<part>.csv, OUT/<part>.md and, for parts 2 and 3, OUT/<part>.png; OUT/bench.md
+collects the markdown tables with the machine and device they were measured on. Times come
+from `vbcl --stats`: device times from OpenCL event profiling, wall times around the render.
+--quick runs every part on tiny images (part of `make test`, so the benchmark cannot rot);
+its numbers only show that each part runs.
+"""
+import argparse
+import csv
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_aa  # noqa: E402  (installs numpy and matplotlib if missing)
+from bench_aa import np, plt, read_exr  # noqa: E402
+
+A4 = "scenes/thesis/a4_two_prisms.json"
+
+# Thesis section 4.1.5 (seconds, IRIS Indigo, 400x400, grid 20x20x20): threshold, depth,
+# dispersion, rendering time, anti-alias time, effect of dispersion, total time.
+THESIS_ROWS = [
+    (1.0, 6, False, 42.03, 0, None, 81.03),
+    (0.8, 6, False, 43.90, 0, None, 82.95),
+    (0.6, 6, False, 42.36, 0.1, None, 83.1),
+    (0.4, 6, False, 42.68, 5.0, None, 89.17),
+    (0.2, 6, False, 42.67, 18.87, None, 102.1),
+    (0.1, 6, False, 42.89, 27.19, None, 112.5),
+    (0.05, 6, False, 42.64, 44.9, None, 128.54),
+    (0.02, 6, False, 42.71, 93.96, None, 174.31),
+    (0.6, 7, False, 48.20, 0.12, None, 88.1),
+    (0.6, 8, False, 54.05, 0.14, None, 93.19),
+    (0.6, 9, False, 62.46, 0.30, None, 101.96),
+    (0.6, 10, False, 74.99, 0.34, None, 115.13),  # printed as threshold "0.610"
+    (0.02, 6, True, 42.67, 95.23, 430.248, 614.148),
+]
+THESIS_QUICK = [THESIS_ROWS[0], THESIS_ROWS[5], THESIS_ROWS[8], THESIS_ROWS[12]]
+
+# Part 2: scenes from ~100 to ~184,000 triangles (name, path, extra options).
+GRID_SCENES = [
+    ("boxes (106 tris)", "scenes/bench/boxes.json", []),
+    ("quickstart (6,038 tris)", "scenes/quickstart.json", []),
+    ("glass_bombed_sphere (94,724 tris, glass)", "scenes/glass_bombed_sphere.json",
+     ["--shadow-samples", "4"]),
+    ("spheres36 (184,322 tris)", "scenes/bench/spheres36.json", []),
+]
+GRID_SIZES = ["5", "8", "16", "32", "64", "128", "auto"]
+GRID_SCENES_QUICK = GRID_SCENES[:2]
+GRID_SIZES_QUICK = ["5", "16", "auto"]
+
+BANDS = [1, 2, 4, 6, 8, 16, 32]
+BANDS_QUICK = [1, 4]
+
+STAT_PATTERNS = {
+    "build_ms": r"^program\s+([\d.]+) ms",
+    "camera_ms": r"camera ([\d.]+) ms",
+    "intersect_ms": r"intersect ([\d.]+) ms",
+    "shading_ms": r"shading\+shadows ([\d.]+) ms",
+    "tree_ms": r"ray trees ([\d.]+) ms",
+    "dispersion_ms": r"dispersive subtrees ([\d.]+) ms",
+    "render_ms": r"\| render ([\d.]+) ms",
+    "write_ms": r"write ([\d.]+) ms",
+    "total_ms": r"total ([\d.]+) ms \(wall\)",
+    "aa_contrast_ms": r"aa time\s+contrast ([\d.]+) ms",
+    "aa_refine_ms": r"refine ([\d.]+) ms \(",
+    "aa_reconstruct_ms": r"reconstruct ([\d.]+) ms",
+    "rays_primary": r"^rays\s+primary (\d+)",
+    "rays_refine": r"refinement (\d+)",
+    "rays_shadow": r"shadow (\d+) \(",
+    "rays_total": r"skipped: light behind the surface\), total (\d+)",
+    "reflected": r"^ray tree\s+reflected (\d+)",
+    "transmitted": r"transmitted (\d+),",
+    "band_rays": r"(\d+) band rays traced",
+    "spp": r"^samples\s+([\d.]+) per pixel",
+    "triangles": r"^scene .*: \d+ objects, (\d+) triangles",
+    "grid": r"^grid\s+(\d+x\d+x\d+)",
+}
+
+
+def run_stats(vbcl, scene, opts, env=None):
+    """Runs vbcl with --stats; returns the numbers of its report (0 where absent)."""
+    cmd = [vbcl, scene, "-q", "--stats"] + opts
+    log = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stderr
+    st = {"cold": "cold:" in log}
+    for k, pat in STAT_PATTERNS.items():
+        m = re.search(pat, log, re.M)
+        st[k] = (m.group(1) if k == "grid" else float(m.group(1))) if m else 0.0
+    return st
+
+
+def median_stats(vbcl, scene, opts, repeats):
+    runs = [run_stats(vbcl, scene, opts) for _ in range(repeats)]
+    runs.sort(key=lambda s: s["total_ms"])
+    return runs[len(runs) // 2]
+
+
+def write_table(out, name, rows, fields, title, note=""):
+    with open(os.path.join(out, name + ".csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    lines = [f"### {title}", ""]
+    if note:
+        lines += [note, ""]
+    lines.append("| " + " | ".join(fields) + " |")
+    lines.append("|" + "---|" * len(fields))
+    for r in rows:
+        lines.append("| " + " | ".join(str(r.get(k, "")) for k in fields) + " |")
+    text = "\n".join(lines) + "\n"
+    with open(os.path.join(out, name + ".md"), "w") as f:
+        f.write(text)
+    print(text, flush=True)
+    return text
+
+
+def with_dispersion(scene):
+    """The scene with the thesis's dispersion on every dielectric (eq. 16-17, its rays)."""
+    with open(scene) as f:
+        data = json.load(f)
+    for m in data["materials"].values():
+        if m.get("k_global", 0) > 0:
+            m["dispersion"] = {"model": "thesis", "spread": 0.03}
+    data.setdefault("render", {})["bands"] = "thesis"
+    path = os.path.join(os.path.dirname(scene), f".bench_disp_{os.getpid()}.json")
+    with open(path, "w") as f:
+        json.dump(data, f)
+    return path
+
+
+def part_thesis(a, out):
+    rows_in = THESIS_QUICK if a.quick else THESIS_ROWS
+    size = a.size or (12 if a.quick else 400)
+    # --quick: one feeler per light and two refinement levels, so that it takes seconds
+    quick = ["--shadow-samples", "1", "--aa-max-level", "2"] if a.quick else []
+    disp_scene = with_dispersion(A4)
+    rows = []
+    try:
+        run_stats(a.vbcl, A4, ["--width", "8", "--height", "8"])  # warm the binary cache
+        for thr, depth, disp, t_render, t_aa, t_disp, t_total in rows_in:
+            scene = disp_scene if disp else A4
+            opts = ["--width", str(size), "--height", str(size), "--aa", str(thr),
+                    "--depth", str(depth), "-o", os.path.join(a.tmp, "thesis.exr")] + quick
+            st = median_stats(a.vbcl, scene, opts, a.repeats)
+            aa = st["aa_contrast_ms"] + st["aa_refine_ms"] + st["aa_reconstruct_ms"]
+            rows.append({
+                "threshold": thr, "depth": depth, "dispersion": "on" if disp else "off",
+                "render_s": f"{(st['render_ms'] - aa) / 1000:.2f}",
+                "aa_s": f"{aa / 1000:.2f}",
+                "dispersion_s": f"{st['dispersion_ms'] / 1000:.2f}" if disp else "N/A",
+                "total_s": f"{st['total_ms'] / 1000:.2f}",
+                "spp": f"{st['spp']:.2f}",
+                "thesis_render_s": t_render, "thesis_aa_s": t_aa,
+                "thesis_dispersion_s": "N/A" if t_disp is None else t_disp,
+                "thesis_total_s": t_total,
+            })
+            print(f"thesis: {thr} depth {depth} disp {disp}: {rows[-1]}", flush=True)
+    finally:
+        os.remove(disp_scene)
+    fields = ["threshold", "depth", "dispersion", "render_s", "aa_s", "dispersion_s", "total_s",
+              "spp", "thesis_render_s", "thesis_aa_s", "thesis_dispersion_s", "thesis_total_s"]
+    note = (f"`{A4}` at {size}x{size} (the thesis: 400x400), grid 20 as in the thesis, "
+            f"median of {a.repeats}. render_s: the render's wall time less the anti-aliasing "
+            "stages' device time; aa_s: contrast, refinement and reconstruction (device); "
+            "dispersion_s: tree_trace_bands, the dispersive subtrees (device, inside render_s "
+            "and aa_s); total_s: the whole run (scene, grid, warm program, render, write). "
+            "thesis_*: section 4.1.5, seconds on an SGI IRIS Indigo (1995).")
+    return write_table(out, "thesis_table", rows, fields, "Thesis section 4.1.5 on figure A.4",
+                       note)
+
+
+def part_grid(a, out):
+    scenes = GRID_SCENES_QUICK if a.quick else GRID_SCENES
+    sizes = GRID_SIZES_QUICK if a.quick else GRID_SIZES
+    size = a.size or (16 if a.quick else 160)
+    rows = []
+    for label, scene, extra in scenes:
+        run_stats(a.vbcl, scene, ["--width", "8", "--height", "8"] + extra)  # warm
+        for g in sizes:
+            opts = ["--width", str(size), "--height", str(size), "--grid", g,
+                    "-o", os.path.join(a.tmp, "grid.exr")] + extra
+            st = median_stats(a.vbcl, scene, opts, a.repeats)
+            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+            secondary = st["reflected"] + st["transmitted"]
+            row = {
+                "scene": label, "triangles": int(st["triangles"]), "grid": g,
+                "cells": st["grid"],
+                "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
+                "shading_mrays_s": (f"{(st['rays_primary'] + st['rays_shadow']) / ((st['shading_ms'] + st['tree_ms']) * 1e3):.2f}"
+                                    if st["shading_ms"] > 0 else ""),
+                "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
+                                      if st["tree_ms"] > 0 else ""),
+                "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
+                "kernel_ms": f"{kern:.1f}",
+            }
+            rows.append(row)
+            print(f"grid: {row}", flush=True)
+    fields = ["scene", "triangles", "grid", "cells", "primary_mrays_s", "shading_mrays_s",
+              "secondary_mrays_s", "all_mrays_s", "kernel_ms"]
+    note = (f"{size}x{size}, median of {a.repeats}. primary: camera rays over the intersect "
+            "kernel's time; shading: primary rays plus all shadow feelers over the shading and "
+            "ray-tree kernels' time; secondary: reflected and transmitted rays over the "
+            "ray-tree kernel's time (which also traces their feelers); all: every ray over "
+            "all tracing kernels' time.")
+    text = write_table(out, "grid_throughput", rows, fields,
+                       "Throughput across grid sizes", note)
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 3.8), squeeze=False)
+    for ax, (label, _, _) in zip(axes[0], scenes):
+        rs = [r for r in rows if r["scene"] == label]
+        xs = list(range(len(rs)))
+        ax.plot(xs, [float(r["all_mrays_s"]) for r in rs], "o-", label="all rays")
+        ax.plot(xs, [float(r["primary_mrays_s"]) for r in rs], "s--", label="primary")
+        ax.set_xticks(xs)
+        ax.set_xticklabels([r["grid"] for r in rs], fontsize=8)
+        ax.set_xlabel("grid (cells per axis)")
+        ax.set_ylabel("Mrays/s")
+        ax.set_yscale("log")
+        ax.set_title(label, fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "grid_throughput.png"), dpi=110)
+    return text
+
+
+def part_error(a, out):
+    # anti-aliasing thresholds: bench_aa.py as it is
+    cmd = [sys.executable, os.path.join(os.path.dirname(__file__), "bench_aa.py"),
+           "--vbcl", a.vbcl, "--out", out, "--repeats", str(a.repeats)]
+    subprocess.run(cmd + (["--quick"] if a.quick else []), check=True)
+    # band counts: prism_dispersion against 64 bands
+    scene = "scenes/prism_dispersion.json"
+    w, h = (16, 12) if a.quick else (240, 160)
+    ref_bands = 16 if a.quick else 64
+    ref_path = os.path.join(a.tmp, "bands_ref.exr")
+    base = ["--width", str(w), "--height", str(h)]
+    ref_st = run_stats(a.vbcl, scene, base + ["--bands", str(ref_bands), "-o", ref_path])
+    ref = np.clip(read_exr(ref_path), 0.0, 1.0)
+    rows = []
+    for nb in (BANDS_QUICK if a.quick else BANDS) + ["thesis"]:
+        img_path = os.path.join(a.tmp, "bands.exr")
+        opts = base + ["--bands", str(nb), "-o", img_path]
+        run_stats(a.vbcl, scene, opts)  # builds this band count's stack size class
+        st = median_stats(a.vbcl, scene, opts, a.repeats)
+        img = np.clip(read_exr(img_path), 0.0, 1.0)
+        rmse = float(np.sqrt(np.mean((img - ref) ** 2)))
+        rows.append({"bands": nb, "render_ms": f"{st['render_ms']:.1f}",
+                     "dispersion_ms": f"{st['dispersion_ms']:.1f}",
+                     "band_rays": int(st["band_rays"]), "rmse": f"{rmse:.5f}",
+                     "psnr_db": f"{20 * np.log10(1 / rmse):.2f}" if rmse > 0 else "inf"})
+        print(f"bands: {rows[-1]}", flush=True)
+    note = (f"`{scene}` at {w}x{h} against {ref_bands} bands ({ref_st['render_ms'] / 1000:.1f} s), "
+            f"linear RGB clamped to [0, 1], median of {a.repeats}; render_ms is the render's "
+            "wall time, dispersion_ms the dispersive subtrees' device time. \"thesis\": the "
+            "thesis's 1 red, 2 green, 3 blue rays (pure primaries, not CIE weights).")
+    text = write_table(out, "bands_time_error", rows,
+                       ["bands", "render_ms", "dispersion_ms", "band_rays", "rmse", "psnr_db"],
+                       "Run time against error: band counts", note)
+    fig, ax = plt.subplots(figsize=(5.2, 4.2))
+    for r in rows:
+        x, y = float(r["render_ms"]) / 1000, max(float(r["rmse"]), 1e-7)
+        ax.plot([x], [y], "o", color="C1" if r["bands"] == "thesis" else "C0")
+        ax.annotate(str(r["bands"]), (x, y), textcoords="offset points", xytext=(4, 4),
+                    fontsize=8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("render time (s)")
+    ax.set_ylabel(f"RMSE vs {ref_bands} bands")
+    ax.set_title(f"prism_dispersion {w}x{h}: bands", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "bands_time_error.png"), dpi=110)
+    with open(os.path.join(out, "aa_time_error.csv")) as f:
+        aa_rows = list(csv.DictReader(f))
+    aa_text = write_table(out, "aa_time_error", aa_rows,
+                          ["scene", "size", "method", "param", "render_ms",
+                           "samples_per_pixel", "rmse", "psnr_db"],
+                          "Run time against error: anti-aliasing",
+                          "Against `--ssaa 16` of the same scene with another seed "
+                          "(scripts/bench_aa.py).")
+    return aa_text + "\n" + text
+
+
+def part_build(a, out):
+    scenes = [("opaque (quickstart)", "scenes/quickstart.json"),
+              ("glass and textures (glass_bombed_sphere)", "scenes/glass_bombed_sphere.json"),
+              ("dispersion (prism_dispersion)", "scenes/prism_dispersion.json")]
+    if a.quick:
+        scenes = scenes[:1]
+    rows = []
+    for label, scene in scenes:
+        for k in range(a.repeats):
+            with tempfile.TemporaryDirectory() as cache:
+                # both caches empty: vbcl's program binaries and PoCL's compiled kernels
+                env = dict(os.environ, VBCL_CACHE_DIR=cache, POCL_CACHE_DIR=cache + "/pocl")
+                opts = ["--width", "8", "--height", "8", "-o", os.path.join(a.tmp, "b.png")]
+                t0 = time.time()
+                cold = run_stats(a.vbcl, scene, opts, env)
+                cold_wall = time.time() - t0
+                t0 = time.time()
+                warm = run_stats(a.vbcl, scene, opts, env)
+                warm_wall = time.time() - t0
+            rows.append({"features": label, "run": k + 1,
+                         "cold_build_ms": f"{cold['build_ms']:.1f}",
+                         "cold_first_render_ms": f"{cold['render_ms']:.1f}",
+                         "cold_process_s": f"{cold_wall:.2f}",
+                         "warm_build_ms": f"{warm['build_ms']:.1f}",
+                         "warm_first_render_ms": f"{warm['render_ms']:.1f}",
+                         "warm_process_s": f"{warm_wall:.2f}"})
+            print(f"build: {rows[-1]}", flush=True)
+    note = ("An 8x8 render with empty caches (cold: clBuildProgram from source; PoCL's own "
+            "kernel cache, POCL_CACHE_DIR, emptied too), then again with the caches the first "
+            "run filled (warm: clCreateProgramWithBinary). "
+            "first_render_ms: the render's wall time, which on PoCL includes compiling each "
+            "kernel's work-group function at its first launch; process_s: the whole command "
+            "(texture generation comes from its own cache in both).")
+    return write_table(out, "build_time", rows,
+                       ["features", "run", "cold_build_ms", "cold_first_render_ms",
+                        "cold_process_s", "warm_build_ms", "warm_first_render_ms",
+                        "warm_process_s"],
+                       "Kernel build time, cold and warm", note)
+
+
+def machine(vbcl):
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            m = re.search(r"^model name\s*:\s*(.*)$", f.read(), re.M)
+            cpu = m.group(1) if m else cpu
+    except OSError:
+        pass
+    dev = subprocess.run([vbcl, "--list-devices"], capture_output=True, text=True).stdout
+    return f"{cpu}, {os.cpu_count()} logical CPUs; OpenCL devices:\n\n```\n{dev.strip()}\n```\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="tiny sizes: every part runs (CI)")
+    ap.add_argument("--parts", default="thesis,grid,error,build")
+    ap.add_argument("--vbcl", default="./vbcl")
+    ap.add_argument("--out", default="bench-out")
+    ap.add_argument("--size", type=int, default=0, help="image size of parts 1 and 2")
+    ap.add_argument("--repeats", type=int, default=None,
+                    help="runs per setting, median (default 3; --quick 1)")
+    a = ap.parse_args()
+    a.repeats = a.repeats or (1 if a.quick else 3)
+    os.makedirs(a.out, exist_ok=True)
+    parts = {"thesis": part_thesis, "grid": part_grid, "error": part_error, "build": part_build}
+    chosen = [p.strip() for p in a.parts.split(",") if p.strip()]
+    for p in chosen:
+        if p not in parts:
+            ap.error(f"--parts: unknown part {p!r} (thesis, grid, error, build)")
+    report = [f"# vbcl benchmarks{' (--quick)' if a.quick else ''}", "",
+              f"Measured {time.strftime('%Y-%m-%d')} on {machine(a.vbcl)}"]
+    t_start = time.time()
+    with tempfile.TemporaryDirectory() as tmp:
+        a.tmp = tmp
+        for p in chosen:
+            t0 = time.time()
+            report.append(parts[p](a, a.out))
+            print(f"bench: part {p} took {time.time() - t0:.0f} s", flush=True)
+    with open(os.path.join(a.out, "bench.md"), "w") as f:
+        f.write("\n".join(report))
+    print(f"bench: wrote {a.out}/bench.md and the CSV, markdown and PNG files beside it "
+          f"({time.time() - t_start:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
