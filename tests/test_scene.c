@@ -357,8 +357,9 @@ static void test_scene_animation(void)
     /* the scene as written: animated, frame 0's values not applied */
     Scene s;
     char err[1024] = "";
-    CHECK(scene_load(path, &s, err, sizeof err) == 0 && s.animated && s.frames == 8, "%s", err);
-    if (!err[0]) scene_free(&s);
+    int rc = scene_load(path, &s, err, sizeof err);
+    CHECK(rc == 0 && s.animated && s.frames == 8, "%s", err);
+    if (rc == 0) scene_free(&s);
     CHECK(scene_load_frame(path, 8, &s, err, sizeof err) == 2 && strstr(err, "animation.frames"),
           "frame 8 of 8: %s", err);
     /* bad tracks */
@@ -390,8 +391,9 @@ static void test_scene_animation(void)
     const char *hot = tu_write_file(
         "anim_range.json",
         ANIM_BAD("{\"target\": \"materials.m.k_global\", \"keys\": [[0, 0.5], [3, 2.5]]}"));
-    CHECK(scene_load_frame(hot, 0, &s, err, sizeof err) == 0, "frame 0: %s", err);
-    if (!err[0]) scene_free(&s);
+    rc = scene_load_frame(hot, 0, &s, err, sizeof err);
+    CHECK(rc == 0, "frame 0: %s", err);
+    if (rc == 0) scene_free(&s);
     CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 && strstr(err, "materials.m.k_global"),
           "frame 3: %s", err);
 #undef ANIM_BAD
