@@ -2,7 +2,8 @@
 # bench_compare.sh — two vbcl binaries on the same scenes, interleaved run by run so that
 # machine noise hits both alike; reports the median kernel time of each and the ratio.
 # usage: scripts/bench_compare.sh OLD_BINARY NEW_BINARY [-n REPEATS] SCENE[:WxH] ...
-# Kernel time = the device stages of --stats (camera + intersect + shading + ray trees).
+# Kernel time = the device stages of --stats (camera + intersect + shading + ray trees +
+# dispersive subtrees).
 set -euo pipefail
 old=$1 new=$2
 shift 2
@@ -17,7 +18,7 @@ kernel_ms() { # binary scene w h -> kernel milliseconds
     "$1" "$2" -q --stats "${size[@]}" -o "$tmp/img.png" 2>&1 |
         awk '/^time/ { s = 0
                        for (i = 1; i <= NF; i++)
-                           if ($i ~ /^(camera|intersect|shading\+shadows|trees)$/) s += $(i + 1)
+                           if ($i ~ /^(camera|intersect|shading\+shadows|trees|subtrees)$/) s += $(i + 1)
                        print s }'
 }
 
