@@ -1034,7 +1034,7 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     }
     ob->first_tri = s->mesh.ntris;
     ob->ntris = m.ntris;
-    if (scene_append(c, s, &m, (uint32_t)i)) goto done;
+    if (scene_append(c, s, &m, (uint32_t)i | (ob->is_host ? 0u : VBCL_TAG_OPAQUE))) goto done;
     ob->first_tex_tri = s->mesh.ntris;
     ob->ntex_tris = tex.ntris;
     if (scene_append(c, s, &tex, (uint32_t)i | VBCL_TAG_TEXTURE)) goto done;

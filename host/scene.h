@@ -85,7 +85,8 @@ typedef struct Scene {
     SceneObject *objects;
     int ntextured;
     Mesh mesh;         /* all objects and textures, world space */
-    uint32_t *tri_tag; /* per triangle: object index | VBCL_TAG_TEXTURE for texture triangles */
+    uint32_t *tri_tag; /* per triangle: object index | VBCL_TAG_TEXTURE (texture triangles) |
+                          VBCL_TAG_OPAQUE (an object that is not a host) */
 } Scene;
 
 /* The texture generator that objects[i].texture.generate runs (texgen_run_quiet):

@@ -174,7 +174,8 @@ VB_INLINE float4 tri_vertex(__global const VbTriangle *tris, int tri, int k)
     return (float4)(p[0], p[1], p[2], 0.0f);
 }
 
-/* The triangle's tag: object index | VBCL_TAG_TEXTURE for volume-texture triangles. */
+/* The triangle's tag: object index | VBCL_TAG_TEXTURE for volume-texture triangles |
+ * VBCL_TAG_OPAQUE for opaque surfaces. */
 VB_INLINE uint tri_tag(__global const VbTriangle *tris, int tri)
 {
     return ((__global const uint *)(tris + tri))[3];
@@ -194,4 +195,36 @@ VB_INLINE float3 tri_point(__global const VbTriangle *tris, VbHit h)
 {
     return (1.0f - h.u - h.v) * tri_vertex(tris, h.tri, 0).xyz +
            h.u * tri_vertex(tris, h.tri, 1).xyz + h.v * tri_vertex(tris, h.tri, 2).xyz;
+}
+
+/* Surfaces in contact: a glass prism standing on a floor has its bottom face in the
+ * floor's plane, and a ray leaving the glass there hits both at the same distance up to
+ * rounding. Were the winner a coin toss per ray, the ray that first crossed the glass
+ * face would start again from an offset origin past the floor and never see it, and the
+ * glass would show a fixed per-pixel speckle of floor and no floor. Contact is decided
+ * here, in every closest-hit search: within this window of the closest hit, an opaque
+ * surface (VBCL_TAG_OPAQUE) comes before a medium boundary, so the ray meets the floor
+ * while still in the glass, as light does where glass touches a floor. The window is 2^-16
+ * of the distances involved (about 128 ulps, the order of the ray offsets, which skip any
+ * thinner gap anyway), far below a gap a scene means. */
+VB_INLINE float hit_contact_window(float3 org, float t)
+{
+    return (1.0f / 65536.0f) * (t + vb_max3(fabs(org)));
+}
+
+/* Whether a hit at t on triangle tri (opaque: its VBCL_TAG_OPAQUE bit) comes before the
+ * best hit so far (best_opaque likewise; window: hit_contact_window at the best hit):
+ * across kinds within the window the opaque one, else the closer one, and of equal t the
+ * lower triangle index. */
+VB_INLINE int hit_before(float t, int tri, uint opaque, VbHit best, uint best_opaque, float window)
+{
+    if (best.tri < 0) return 1;
+    if (opaque != best_opaque) return opaque ? t <= best.t + window : t + window < best.t;
+    return t < best.t || (t == best.t && tri < best.tri);
+}
+
+/* How far a candidate hit may lie and still come before the best hit (see hit_before). */
+VB_INLINE float hit_reach(VbHit best, uint best_opaque, float window, float tmax)
+{
+    return best.tri < 0 || best_opaque ? best.t : fmin(tmax, best.t + window);
 }

@@ -77,7 +77,8 @@ VB_INLINE int grid_cell_index(__constant const VbGrid *g, int3 c)
 }
 
 /* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell is
- * accepted only if it lies before the cell's exit, so a triangle that also spans later
+ * accepted only if it (and the window in which an opaque surface in contact would still
+ * come first, hit_before) lies before the cell's exit, so a triangle that also spans later
  * cells cannot hide a closer one there. Ties go to the lower triangle index. */
 VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
                                    __global const uint *cell_start, __global const uint *cell_tris,
@@ -90,7 +91,8 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return hit;
     RayShear rs = ray_shear_make(org, dir);
-    uint steps = 0, tests = 0;
+    uint steps = 0, tests = 0, hit_opaque = 0u;
+    float window = 0.0f, reach = tmax;
     do {
         steps++;
         int ci = grid_cell_index(g, w.cell);
@@ -100,17 +102,21 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
             int tri = (int)cell_tris[k];
             float t, u, v;
             if (tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                              tri_vertex(tris, tri, 2), hit.t, &t, &u, &v)) {
-                if (hit.tri < 0 || t < hit.t || (t == hit.t && tri < hit.tri)) {
+                              tri_vertex(tris, tri, 2), reach, &t, &u, &v)) {
+                uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
+                if (hit_before(t, tri, opaque, hit, hit_opaque, window)) {
                     hit.t = t;
                     hit.tri = tri;
                     hit.u = u;
                     hit.v = v;
+                    hit_opaque = opaque;
+                    window = hit_contact_window(org, t);
+                    reach = hit_reach(hit, hit_opaque, window, tmax);
                 }
             }
         }
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
-        if (hit.tri >= 0 && hit.t <= cell_exit) break;
+        if (hit.tri >= 0 && reach <= cell_exit) break;
     } while (grid_walk_next(g, &w));
     count->steps += steps;
     count->tests += tests;

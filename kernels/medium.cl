@@ -28,7 +28,7 @@ VB_INLINE Crossing medium_cross(const DevScene *sc, int tri, float3 dir, VbMediu
 {
     Crossing c;
     uint tag = tri_tag(sc->tris, tri);
-    uint obj = tag & ~VBCL_TAG_TEXTURE;
+    uint obj = tag & ~VBCL_TAG_FLAGS;
     VbObject o = sc->objects[obj];
     int entering = dot(tri_normal(sc->tris, tri), dir) < 0.0f; /* normals point outward */
     c.after = before;

@@ -12,15 +12,22 @@ __kernel void probe_intersect_brute(__global const VbTriangle *tris, uint ntris,
     VbRay r = rays[i];
     RayShear rs = ray_shear_make(vb_load3(r.org), vb_load3(r.dir));
     VbHit hit = {r.tmax, -1, 0.0f, 0.0f};
+    uint hit_opaque = 0u;
+    float window = 0.0f, reach = r.tmax;
     for (uint k = 0; k < ntris; k++) {
         float t, u, v;
-        if (tri_intersect(&rs, tri_vertex(tris, k, 0), tri_vertex(tris, k, 1),
-                          tri_vertex(tris, k, 2), hit.t, &t, &u, &v) &&
-            (hit.tri < 0 || t < hit.t)) {
+        if (!tri_intersect(&rs, tri_vertex(tris, k, 0), tri_vertex(tris, k, 1),
+                           tri_vertex(tris, k, 2), reach, &t, &u, &v))
+            continue;
+        uint opaque = tri_tag(tris, (int)k) & VBCL_TAG_OPAQUE;
+        if (hit_before(t, (int)k, opaque, hit, hit_opaque, window)) {
             hit.t = t;
             hit.tri = (int)k;
             hit.u = u;
             hit.v = v;
+            hit_opaque = opaque;
+            window = hit_contact_window(vb_load3(r.org), t);
+            reach = hit_reach(hit, hit_opaque, window, r.tmax);
         }
     }
     hits[i] = hit;

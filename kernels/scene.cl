@@ -57,5 +57,5 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
 /* Material of an opaque-scene triangle: its object's own material. */
 VB_INLINE uint scene_tri_material(const DevScene *sc, int tri)
 {
-    return sc->objects[tri_tag(sc->tris, tri) & ~VBCL_TAG_TEXTURE].material;
+    return sc->objects[tri_tag(sc->tris, tri) & ~VBCL_TAG_FLAGS].material;
 }

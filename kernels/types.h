@@ -28,9 +28,13 @@
  * an 8-bit count of elements per textured object. */
 #define VBCL_MAX_TEXTURED 4
 
-/* The tag in a triangle's v0[3]: the object index, with this bit set for triangles of
- * the object's volume texture. */
+/* The tag in a triangle's v0[3]: the object index, with VBCL_TAG_TEXTURE set for triangles
+ * of the object's volume texture and VBCL_TAG_OPAQUE for triangles of an object that bounds
+ * no tracked volume (an opaque surface: the closest-hit search prefers it where it touches
+ * a medium boundary, geometry.cl hit_before). */
 #define VBCL_TAG_TEXTURE 0x80000000u
+#define VBCL_TAG_OPAQUE  0x40000000u
+#define VBCL_TAG_FLAGS   (VBCL_TAG_TEXTURE | VBCL_TAG_OPAQUE)
 
 /* VbObject.flags */
 #define VBCL_OBJECT_HOST 1u /* a closed volume whose inside the medium state tracks */

@@ -164,6 +164,71 @@ static void test_grid_matches_brute_force(void)
     compare_grid_brute("spheres and a slab", spheres, "[7, 3, 19]", 100000);
 }
 
+/* A glass box standing on an opaque floor: its bottom face lies in the floor's plane.
+ * Rays from inside the glass toward the bottom meet both at the same distance up to
+ * rounding; the floor, the surface in contact with the glass, must win every time, in the
+ * grid and in brute force (before the contact rule about half of them found the glass face,
+ * and the next ray's offset origin then skipped the floor: a per-pixel speckle). */
+static void test_contact_opaque_surface_first(void)
+{
+    static const char *json =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"floor\": {}, \"glass\": "
+        "{\"k_global\": 1, \"eta\": 1.5}}, \"objects\": ["
+        "{\"shape\": \"quad\", \"size\": [4, 4], \"material\": \"floor\"},"
+        "{\"shape\": \"box\", \"material\": \"glass\", \"transform\": {\"rotate\": [0, 15, "
+        "0], \"translate\": [0.3, 0.5, -0.2]}}]}";
+    static const char *grids[] = {"1", "\"auto\"", "[7, 5, 3]"};
+    enum { N = 20000 };
+    for (int g = 0; g < 3; g++) {
+        char text[2048];
+        snprintf(text, sizeof text, json, grids[g]);
+        Fixture fx;
+        if (fixture_open(&fx, text)) return;
+        VbRay *rays = calloc(N, sizeof *rays);
+        VbHit *hg = calloc(N, sizeof *hg), *hb = calloc(N, sizeof *hb);
+        unsigned seed = 777u + (unsigned)g;
+        for (int i = 0; i < N; i++) { /* from inside the box, down to its bottom face */
+            float x = 0.3f + 0.4f * (frand(&seed) - 0.5f), z = -0.2f + 0.4f * (frand(&seed) - 0.5f);
+            vec3 d = v3_norm(v3(0.5f * (frand(&seed) - 0.5f), -1.0f, 0.5f * (frand(&seed) - 0.5f)));
+            rays[i] =
+                (VbRay){{x, 0.1f + 0.8f * frand(&seed), z}, INFINITY, {d.x, d.y, d.z}, (cl_uint)i};
+        }
+        cl_mem mr = buffer(rays, sizeof *rays * N);
+        cl_mem mg = buffer(NULL, sizeof *hg * N), mb = buffer(NULL, sizeof *hb * N);
+        cl_uint zero[VBCL_COUNTERS] = {0};
+        cl_mem mc = buffer(zero, sizeof zero);
+        trace_grid(&fx, mr, N, mg, mc);
+        cl_uint ntris = fx.s.mesh.ntris;
+        int n = N;
+        const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
+                             sizeof(cl_mem)};
+        const void *v[] = {&fx.r.tris, &ntris, &mr, &n, &mb};
+        run_kernel(fx.r.program, "probe_intersect_brute", N, 5, sz, v);
+        read_buffer(mg, hg, sizeof *hg * N);
+        read_buffer(mb, hb, sizeof *hb * N);
+        int floor_g = 0, floor_b = 0;
+        for (int i = 0; i < N; i++) {
+            floor_g += hg[i].tri >= 0 && (fx.s.tri_tag[hg[i].tri] & ~VBCL_TAG_FLAGS) == 0;
+            floor_b += hb[i].tri >= 0 && (fx.s.tri_tag[hb[i].tri] & ~VBCL_TAG_FLAGS) == 0;
+        }
+        fprintf(stderr,
+                "    grid %s: %d of %d rays from inside the glass hit the floor (brute "
+                "force %d)\n",
+                grids[g], floor_g, N, floor_b);
+        CHECK(floor_g == N && floor_b == N,
+              "grid %s: the floor in contact must come first: grid %d, brute force %d of %d",
+              grids[g], floor_g, floor_b, N);
+        clReleaseMemObject(mr);
+        clReleaseMemObject(mg);
+        clReleaseMemObject(mb);
+        clReleaseMemObject(mc);
+        free(rays);
+        free(hg);
+        free(hb);
+        fixture_close(&fx);
+    }
+}
+
 /* Local shading at points under a spherical light, diffuse reflectance 1, no ambient:
  * outgoing radiance = E / pi with E = pi L sin^2(alpha) cos(beta) whenever the whole cap
  * is above the horizon (alpha: the cap's half angle, beta: the tilt of the normal). */
@@ -329,6 +394,7 @@ void suite_kernels(void)
     RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
+    RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
 }
