@@ -10,11 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Creates the anti-aliasing kernels and buffers (film, level map, mark list) once.
+/* Creates the anti-aliasing buffers (film, level map, mark list) once.
  * Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
-static int aa_setup(Renderer *r, const Scene *s, char *err, size_t errlen)
+static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t errlen)
 {
-    if (r->k_aa_generate) return 0;
+    if (aa->pass) return 0;
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
     if (sizeof(float) * 4 * npix > d->max_alloc) {
@@ -25,34 +25,22 @@ static int aa_setup(Renderer *r, const Scene *s, char *err, size_t errlen)
                  (double)d->max_alloc / 1048576.0);
         return 2;
     }
-    cl_int rc;
-    r->k_aa_generate = clCreateKernel(r->program, "aa_generate_rays", &rc);
-    CL_CHECK_ERR(rc, "clCreateKernel(aa_generate_rays)", fail);
-    r->k_aa_contrast = clCreateKernel(r->program, "aa_contrast_mark", &rc);
-    CL_CHECK_ERR(rc, "clCreateKernel(aa_contrast_mark)", fail);
-    r->k_aa_reconstruct = clCreateKernel(r->program, "aa_reconstruct", &rc);
-    CL_CHECK_ERR(rc, "clCreateKernel(aa_reconstruct)", fail);
-    renderer_fit_local_size(r, r->k_aa_generate);
-    renderer_fit_local_size(r, r->k_aa_contrast);
-    renderer_fit_local_size(r, r->k_aa_reconstruct);
-    r->aa_pass = clu_buffer(d, NULL, sizeof(VbAaPass), CL_MEM_READ_WRITE);
-    r->film = clu_buffer(d, NULL, sizeof(float) * 4 * npix, CL_MEM_READ_WRITE);
-    r->levels = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
-    r->marks = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
-    r->mark_counts = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, CL_MEM_READ_WRITE);
-    if (!r->aa_pass || !r->film || !r->levels || !r->marks || !r->mark_counts) goto fail;
-    return 0;
-fail:
+    aa->pass = clu_buffer(d, NULL, sizeof(VbAaPass), CL_MEM_READ_WRITE);
+    aa->film = clu_buffer(d, NULL, sizeof(float) * 4 * npix, CL_MEM_READ_WRITE);
+    aa->levels = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    aa->marks = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
+    aa->mark_counts = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, CL_MEM_READ_WRITE);
+    if (aa->pass && aa->film && aa->levels && aa->marks && aa->mark_counts) return 0;
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
 }
 
-/* Supersamples `count` pixels — list entries first.. of r->marks, or pixels first.. with
+/* Supersamples `count` pixels — list entries first.. of aa->marks, or pixels first.. with
  * pass->identity — with side x side samples each, in batches that fit the ray buffers;
  * each batch is generated, traced by the frame's kernels and reconstructed into the film.
  * Returns 0, or -1 with the error recorded. */
-static int aa_run_batches(Renderer *r, VbAaPass *pass, unsigned first, unsigned count, int side,
-                          RenderStats *st)
+static int aa_run_batches(AaState *aa, Renderer *r, VbAaPass *pass, unsigned first, unsigned count,
+                          int side, RenderStats *st)
 {
     VbDevice *d = r->dev;
     unsigned nsub = (unsigned)(side * side);
@@ -66,21 +54,21 @@ static int aa_run_batches(Renderer *r, VbAaPass *pass, unsigned first, unsigned 
         size_t g_rays = ((size_t)nrays + 63) / 64 * 64, g_pix = ((size_t)k + 63) / 64 * 64;
         pass->first = first + done;
         pass->entries = k;
-        CL_CHECK(clEnqueueWriteBuffer(d->queue, r->aa_pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL,
-                                      NULL),
-                 fail);
-        const cl_uint a = RENDER_SCENE_ARGS + 6;
+        CL_CHECK(
+            clEnqueueWriteBuffer(d->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL, NULL),
+            fail);
+        const cl_uint a = RENDER_FRAME_ARGS;
         if (renderer_set_frame_args(r, r->k_aa_generate, r->rays, nrays, r->hits, r->media,
                                     r->radiance, r->counters) ||
-            clu_set_arg(r->k_aa_generate, a, sizeof(cl_mem), &r->aa_pass) ||
-            clu_set_arg(r->k_aa_generate, a + 1, sizeof(cl_mem), &r->marks))
+            clu_set_arg(r->k_aa_generate, a, sizeof(cl_mem), &aa->pass) ||
+            clu_set_arg(r->k_aa_generate, a + 1, sizeof(cl_mem), &aa->marks))
             goto fail;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_generate, 1, NULL, &g_rays,
                                         renderer_local(r, g_rays), 0, NULL, &ev[0]),
                  fail);
         double trace_ms = 0.0;
         if (renderer_trace_rays(r, nrays, st, &trace_ms)) goto fail;
-        const cl_mem args[5] = {r->aa_pass, r->marks, r->radiance, r->film, r->levels};
+        const cl_mem args[5] = {aa->pass, aa->marks, r->radiance, aa->film, aa->levels};
         for (cl_uint i = 0; i < 5; i++)
             if (clu_set_arg(r->k_aa_reconstruct, i, sizeof(cl_mem), &args[i])) goto fail;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_reconstruct, 1, NULL, &g_pix,
@@ -101,27 +89,28 @@ static int aa_run_batches(Renderer *r, VbAaPass *pass, unsigned first, unsigned 
     return 0;
 }
 
-/* The contrast pass: marks the pixels to refine into per-level segments of r->marks.
+/* The contrast pass: marks the pixels to refine into per-level segments of aa->marks.
  * counts[l] receives how many pixels at level l were marked. Returns 0 or -1. */
-static int aa_mark(Renderer *r, const Scene *s, VbAaPass *pass, cl_uint counts[], RenderStats *st)
+static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, cl_uint counts[],
+                   RenderStats *st)
 {
     VbDevice *d = r->dev;
     cl_event ev = NULL;
     cl_uint zero[VBCL_AA_MAX_LEVEL] = {0};
     size_t npix = (size_t)s->width * (size_t)s->height, global = (npix + 63) / 64 * 64;
     CL_CHECK(
-        clEnqueueWriteBuffer(d->queue, r->aa_pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL, NULL),
+        clEnqueueWriteBuffer(d->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL, NULL),
         fail);
-    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->mark_counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL,
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->mark_counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL,
                                   NULL),
              fail);
-    const cl_mem args[5] = {r->aa_pass, r->film, r->levels, r->marks, r->mark_counts};
+    const cl_mem args[5] = {aa->pass, aa->film, aa->levels, aa->marks, aa->mark_counts};
     for (cl_uint i = 0; i < 5; i++)
         if (clu_set_arg(r->k_aa_contrast, i, sizeof(cl_mem), &args[i])) goto fail;
     CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_contrast, 1, NULL, &global,
                                     renderer_local(r, global), 0, NULL, &ev),
              fail);
-    CL_CHECK(clEnqueueReadBuffer(d->queue, r->mark_counts, CL_TRUE, 0,
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->mark_counts, CL_TRUE, 0,
                                  sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, counts, 0, NULL, NULL),
              fail);
     st->aa_contrast_ms += clu_event_ms(ev);
@@ -142,9 +131,10 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     pass->height = s->height;
 }
 
-int aa_refine(Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *err, size_t errlen)
+int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *err,
+              size_t errlen)
 {
-    int rc = aa_setup(r, s, err, errlen);
+    int rc = aa_setup(aa, r, s, err, errlen);
     if (rc) return rc;
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
@@ -153,18 +143,19 @@ int aa_refine(Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *e
     VbAaPass pass;
     pass_init(&pass, s);
     pass.write_level = 1;
-    r->aa_levels = malloc(sizeof(int) * npix);
-    if (!r->aa_levels) {
+    free(aa->levels_host);
+    aa->levels_host = malloc(sizeof(int) * npix);
+    if (!aa->levels_host) {
         snprintf(err, errlen, "out of memory");
         return 1;
     }
-    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->frame, CL_TRUE, 0, sizeof r->frame_host,
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof r->frame_host,
                                   &r->frame_host, 0, NULL, NULL),
              fail);
-    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                   NULL, NULL),
              fail);
-    CL_CHECK(clEnqueueFillBuffer(d->queue, r->levels, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->levels, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
                                  0, NULL, NULL),
              fail);
     for (int round = 0; round < AA_MAX_ROUNDS; round++) {
@@ -174,7 +165,7 @@ int aa_refine(Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *e
             pass.seg_offset[l] = (unsigned)offset;
             offset += at_level[l];
         }
-        if (aa_mark(r, s, &pass, counts, st)) goto fail;
+        if (aa_mark(aa, r, s, &pass, counts, st)) goto fail;
         for (int l = 0; l < VBCL_AA_MAX_LEVEL; l++) marked += counts[l];
         if (marked == 0) break;
         st->aa_rounds++;
@@ -182,25 +173,25 @@ int aa_refine(Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *e
         for (int l = VBCL_AA_MAX_LEVEL - 1; l >= 0; l--) {
             if (!counts[l]) continue;
             pass.level = l + 1;
-            if (aa_run_batches(r, &pass, pass.seg_offset[l], counts[l], 1 << (l + 1), st))
+            if (aa_run_batches(aa, r, &pass, pass.seg_offset[l], counts[l], 1 << (l + 1), st))
                 goto fail;
             st->aa_refined[l + 1] += counts[l];
             at_level[l] -= counts[l];
             at_level[l + 1] += counts[l];
         }
     }
-    CL_CHECK(clEnqueueReadBuffer(d->queue, r->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
              fail);
-    CL_CHECK(clEnqueueReadBuffer(d->queue, r->levels, CL_TRUE, 0, sizeof(int) * npix, r->aa_levels,
-                                 0, NULL, NULL),
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->levels, CL_TRUE, 0, sizeof(int) * npix,
+                                 aa->levels_host, 0, NULL, NULL),
              fail);
     /* samples of a pixel at level L: its centre, then 4 + 16 + ... + 4^L */
     st->samples = 0;
     st->samples_max = 1;
     for (size_t i = 0; i < npix; i++) {
         unsigned n = 1;
-        for (int l = 1; l <= r->aa_levels[i]; l++) n += 1u << (2 * l);
+        for (int l = 1; l <= aa->levels_host[i]; l++) n += 1u << (2 * l);
         st->samples += n;
         if (n > st->samples_max) st->samples_max = n;
     }
@@ -210,21 +201,21 @@ fail:
     return 1;
 }
 
-int aa_supersample(Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st, char *err,
-                   size_t errlen)
+int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st,
+                   char *err, size_t errlen)
 {
-    int rc = aa_setup(r, s, err, errlen);
+    int rc = aa_setup(aa, r, s, err, errlen);
     if (rc) return rc;
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
     VbAaPass pass;
     pass_init(&pass, s);
     pass.identity = 1;
-    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->frame, CL_TRUE, 0, sizeof r->frame_host,
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof r->frame_host,
                                   &r->frame_host, 0, NULL, NULL),
              fail);
-    if (aa_run_batches(r, &pass, 0, (unsigned)npix, n, st)) goto fail;
-    CL_CHECK(clEnqueueReadBuffer(d->queue, r->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
+    if (aa_run_batches(aa, r, &pass, 0, (unsigned)npix, n, st)) goto fail;
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
              fail);
     st->samples = (unsigned long long)npix * (unsigned long long)(n * n);
@@ -233,6 +224,15 @@ int aa_supersample(Renderer *r, const Scene *s, int n, float *rgba, RenderStats 
 fail:
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
+}
+
+void aa_release(AaState *aa)
+{
+    cl_mem *mems[] = {&aa->pass, &aa->film, &aa->levels, &aa->marks, &aa->mark_counts};
+    for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
+        if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
+    free(aa->levels_host);
+    memset(aa, 0, sizeof *aa);
 }
 
 void aa_level_colour(int level, float rgb[3])

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "aa.h"
+#include "frame.h"
 #include "clu.h"
 #include "kernel_features.h"
 #include "image_io.h"
@@ -414,7 +415,8 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     char *out = rc ? NULL : output_path(o, &s, frame);
     char *map = (rc || !o->aa_map) ? NULL : frame_path(o->aa_map, frame);
     float *rgba = NULL;
-    Renderer r = {0};
+    Frame fr;
+    memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
     if (rc) goto done_scene;
@@ -434,13 +436,13 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
         rc = 1;
         goto done_scene;
     }
-    rc = renderer_init(&r, dev, &s, NULL, &st, err, sizeof err);
+    rc = frame_init(&fr, dev, &s, &st, err, sizeof err);
     if (rc) {
         fprintf(stderr, "vbcl: %s\n", err);
         goto done_renderer;
     }
     int progress = !o->quiet && isatty(STDERR_FILENO);
-    if (renderer_render(&r, &s, rgba, &st, progress, err, sizeof err)) {
+    if (frame_render(&fr, &s, rgba, &st, progress, err, sizeof err)) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 1;
         goto done_renderer;
@@ -451,7 +453,7 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
         rc = 1;
         goto done_renderer;
     }
-    if (map && r.aa_levels && write_aa_map(map, &s, r.aa_levels, err, sizeof err)) {
+    if (map && frame_levels(&fr) && write_aa_map(map, &s, frame_levels(&fr), err, sizeof err)) {
         fprintf(stderr, "vbcl: %s\n", err);
         rc = 1;
         goto done_renderer;
@@ -459,7 +461,7 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
     if (o->stats) {
         if (frame >= 0) fprintf(stderr, "frame       %d of %d\n", frame, s.frames);
-        print_stats(&s, dev, &r, &st, write_ms, total_ms);
+        print_stats(&s, dev, &fr.r, &st, write_ms, total_ms);
     }
     if (!o->quiet) {
         unsigned long long rays =
@@ -471,7 +473,7 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     }
     rc = 0;
 done_renderer:
-    renderer_release(&r);
+    frame_release(&fr);
 done_scene:
     free(rgba);
     free(out);

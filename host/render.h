@@ -1,10 +1,13 @@
-/* render.h — renders a loaded scene on an OpenCL device: builds the grid and the
- * program, uploads the scene, and runs the frame's kernels tile by tile. */
+/* render.h — traces rays of a loaded scene on an OpenCL device: builds the grid and the
+ * program, uploads the scene, and runs the tracing kernels on a batch of rays (a tile of
+ * pass 0, or anti-aliasing's subpixels). The frame driver (frame.h) runs a whole image. */
 #ifndef VBCL_RENDER_H
 #define VBCL_RENDER_H
 
 #include "clu.h"
+#include "device_scene.h"
 #include "grid.h"
+#include "kernel_features.h"
 #include "scene.h"
 
 /* What a render did and how long each part took (--stats). */
@@ -33,20 +36,29 @@ typedef struct RenderStats {
     double aa_contrast_ms, aa_refine_ms, aa_reconstruct_ms; /* event profiling */
 } RenderStats;
 
-/* A scene on a device, ready to render. */
+/* The kernels of the program, one list: X(Renderer field suffix, kernel name, the
+ * VBCL_FEATURE_* bits without which the program has no such kernel). */
+#define RENDER_KERNELS(X)                                                                          \
+    X(camera, "camera_generate_rays", 0u)                                                          \
+    X(intersect, "scene_intersect_closest", 0u)                                                    \
+    X(shading, "light_sample_shading", 0u)                                                         \
+    X(tree, "tree_trace_secondary", VBCL_FEATURE_TRANSPARENCY)                                     \
+    X(bands, "tree_trace_bands", VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)              \
+    X(aa_generate, "aa_generate_rays", 0u)                                                         \
+    X(aa_contrast, "aa_contrast_mark", 0u)                                                         \
+    X(aa_reconstruct, "aa_reconstruct", 0u)
+
+/* A scene on a device, ready to trace: its buffers, the program and its kernels, and one
+ * batch of rays (camera rays of a tile, or subpixel rays of anti-aliasing) at a time. */
 typedef struct Renderer {
     VbDevice *dev;
     cl_program program;
-    cl_kernel k_camera, k_intersect, k_shading, k_tree; /* k_tree: with transparency */
-    cl_kernel k_bands;                                  /* tree_trace_bands: with dispersion */
-    cl_mem tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels;
-    cl_mem frame;
+#define RENDER_KERNEL_FIELD(id, name, needs) cl_kernel k_##id;
+    RENDER_KERNELS(RENDER_KERNEL_FIELD) /* NULL where the features leave one out */
+#undef RENDER_KERNEL_FIELD
+    SceneBuffers buf;
     cl_mem rays, hits, media, radiance, counters;
     cl_mem splits; /* dispersion: one VbSplitSet per ray */
-    /* anti-aliasing, created on first use (host/aa.c) */
-    cl_kernel k_aa_generate, k_aa_contrast, k_aa_reconstruct;
-    cl_mem aa_pass, film, levels, marks, mark_counts;
-    int *aa_levels; /* after an adaptive render: each pixel's refinement level, else NULL */
     Grid grid;
     VbFrame frame_host;
     int tile_pixels;
@@ -55,8 +67,10 @@ typedef struct Renderer {
                         * the driver's choice: fixed, so that PoCL compiles one work-group
                         * function per kernel however the batch sizes vary */
     unsigned features;
-    unsigned band_weights; /* dispersion: first float of the band weights in texels */
 } Renderer;
+
+/* The ray buffers hold at least one pixel's samples at the deepest anti-aliasing level. */
+#define RENDER_MIN_BATCH_RAYS (1 << (2 * VBCL_AA_MAX_LEVEL))
 
 /* Prepares s for rendering on dev: grid, program (extra build options appended, may be
  * NULL), buffers. Returns 0, or 1 (device failure) / 2 (the scene cannot be rendered as
@@ -64,18 +78,14 @@ typedef struct Renderer {
 int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
                   RenderStats *st, char *err, size_t errlen);
 
-/* Renders the whole image into rgba (width*height*4 floats, linear, row 0 at the top):
- * one ray through each pixel centre, then with s->aa_threshold > 0 adaptive refinement
- * (r->aa_levels holds the levels reached); with s->ssaa > 1 instead N x N samples in
- * every pixel. With progress set, reports progress on stderr once the render has taken a
- * second. Returns 0, or 1 with a message in err. */
-int renderer_render(Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
-                    char *err, size_t errlen);
+/* Traces one tile of pass 0: a ray through the centre of each of the n pixels from
+ * pixel `first` on, into rgba + 4 * first (n <= r->tile_pixels). Returns 0, or -1 with the
+ * error recorded (clu_error). */
+int renderer_trace_tile(Renderer *r, long first, int n, float *rgba, RenderStats *st);
 
-/* The scene arguments every frame kernel (and every shading probe) starts with: frame,
- * tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels. */
-#define RENDER_SCENE_ARGS 10
-int renderer_set_scene_args(const Renderer *r, cl_kernel k);
+/* The arguments a frame kernel starts with: the scene's (device_scene.h), then rays,
+ * nrays, hits, media, radiance, counters. Kernels with more take them from here on. */
+#define RENDER_FRAME_ARGS (SCENE_BUFFER_ARGS + 6)
 
 /* Sets all arguments of a frame kernel: the scene's, then rays, nrays, hits, media,
  * radiance, counters. */

@@ -2,6 +2,11 @@
 /* aa.cl — adaptive anti-aliasing on contrast masks (thesis 4.1.2, figures 4.2–4.4) and
  * uniform supersampling: the contrast test, subpixel positions, sample ids, and the box
  * window that reconstructs a pixel from its samples. The entry points are in render.cl. */
+#ifndef VBCL_AA_CL
+#define VBCL_AA_CL
+
+#include "sample.cl"
+#include "types.h"
 
 /* A pixel's value for the contrast test: scaled by 2^exposure and clamped to [0, 1], so
  * that differences a display cannot show (above white) do not refine. */
@@ -49,3 +54,5 @@ VB_INLINE uint aa_sample_id(uint pixel, int side, uint sub)
     if (side == 1) return pixel;
     return vb_hash(pixel ^ vb_hash(((uint)side << 16) ^ sub ^ 0x5bd1e995u));
 }
+
+#endif

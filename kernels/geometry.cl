@@ -1,42 +1,10 @@
 #line 2 "geometry.cl"
-/* geometry.cl — device-side vector helpers, robust ray origins (Waechter & Binder 2019)
- * and watertight ray/triangle intersection (Woop, Benthin & Wald 2013). */
+/* geometry.cl — robust ray origins (Waechter & Binder 2019), watertight ray/triangle
+ * intersection (Woop, Benthin & Wald 2013), triangle access and the closest-hit rule. */
+#ifndef VBCL_GEOMETRY_CL
+#define VBCL_GEOMETRY_CL
 
-/* Contraction into fused multiply-adds would make the edge functions of two triangles
- * sharing an edge differ, and rays could slip between them. */
-#pragma OPENCL FP_CONTRACT OFF
-
-#ifdef cl_khr_fp64
-#pragma OPENCL EXTENSION cl_khr_fp64 : enable
-#endif
-
-#define VB_PI 3.14159265358979323846f
-
-/* Hot helpers must be inlined: on CPU drivers a call passes structs through the stack
- * and every counter update becomes a store and a reload. */
-#ifdef __clang__
-#define VB_INLINE inline __attribute__((always_inline))
-#else
-#define VB_INLINE inline
-#endif
-
-inline float3 vb_load3(const float *p)
-{
-    return (float3)(p[0], p[1], p[2]);
-}
-inline float3 vb_gload3(__global const float *p)
-{
-    return (float3)(p[0], p[1], p[2]);
-}
-inline float3 vb_cload3(__constant const float *p)
-{
-    return (float3)(p[0], p[1], p[2]);
-}
-
-inline float vb_max3(float3 v)
-{
-    return fmax(v.x, fmax(v.y, v.z));
-}
+#include "types.h"
 
 /* Moves a point p on a surface off it along the geometric normal n (pointing to the
  * side the new ray leaves into), so that a ray from the result cannot hit the surface it
@@ -228,3 +196,5 @@ VB_INLINE float hit_reach(VbHit best, uint best_opaque, float window, float tmax
 {
     return best.tri < 0 || best_opaque ? best.t : fmin(tmax, best.t + window);
 }
+
+#endif

@@ -1,6 +1,10 @@
 #line 2 "grid.cl"
 /* grid.cl — uniform-grid traversal (Amanatides & Woo 1987): closest hit, accepted only
  * inside the current cell, and any hit for shadow feelers. */
+#ifndef VBCL_GRID_CL
+#define VBCL_GRID_CL
+
+#include "geometry.cl"
 
 /* Work counters of one ray, summed by the caller into the frame counters. */
 typedef struct TraceCount {
@@ -150,3 +154,5 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
     count->tests += tests;
     return blocked;
 }
+
+#endif

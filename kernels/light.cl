@@ -1,22 +1,12 @@
 #line 2 "light.cl"
 /* light.cl — local shading (thesis 4.1.1, 4.1.4): ambient + diffuse + specular from
  * spherical lights, with shadow feelers to stratified points on the visible cap. */
+#ifndef VBCL_LIGHT_CL
+#define VBCL_LIGHT_CL
 
-/* Integer hash (lowbias32): decorrelated jitter from a pixel, light and stratum. */
-VB_INLINE uint vb_hash(uint x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
-VB_INLINE float vb_unit_float(uint h)
-{
-    return (float)(h >> 8) * (1.0f / 16777216.0f);
-}
+#include "medium.cl"
+#include "sample.cl"
+#include "scene.cl"
 
 /* Solid angle of the cap of a sphere of radius r seen from distance d > r:
  * 2 pi (1 - cos theta_max), with sin theta_max = r / d. */
@@ -69,11 +59,98 @@ typedef struct ShadowCount {
     uint skipped;
 } ShadowCount;
 
+/* What shading a point under one light needs besides the point itself: the BRDF's
+ * terms, where its feelers start, and where the light's centre is. */
+typedef struct LightShading {
+    float3 kd; /* diffuse / pi */
+#ifdef VBCL_HAS_SPECULAR
+    float3 ks;
+    float spec_norm; /* normalises the Blinn-Phong lobe: (n + 8) / (8 pi) */
+    float nh_min;    /* (N.H)^n < 1e-4 below this cosine: such samples skip the costly pow */
+    float exponent;
+#endif
+    float3 origin; /* feelers start here, off the surface on the viewer's side */
+    float3 to_c;   /* from the point to the light's centre */
+    float d2, d;   /* its squared length and length */
+} LightShading;
+
+#ifdef VBCL_HAS_AREA_LIGHTS
+/* The direction of the feeler in stratum (i, j) of the cap of half-angle theta_max around
+ * wc (frame tx, ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle, at a
+ * jittered point of the stratum or at its centre. */
+VB_INLINE float3 light_cap_direction(uint i, uint j, uint strata, uint key, int jitter,
+                                     float one_minus_cos, float3 tx, float3 ty, float3 wc)
+{
+    uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
+    float u1 = ((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata;
+    float u2 = ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata;
+    float cos_t = 1.0f - u1 * one_minus_cos;
+    float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
+    float phi = 2.0f * VB_PI * u2;
+    return normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+}
+
+/* Reflected radiance from a spherical light of radius r > 0 that the point sees from
+ * outside: the visible cap sampled at strata^2 stratified directions, each direction's
+ * feeler traced to the sphere, L * Omega * mean(V * f * cos). */
+VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
+                                    const LightShading *ls, float3 radiance, float r, uint key,
+                                    TraceCount *tc, ShadowCount *sc)
+{
+    uint strata = scn->f->shadow_strata;
+    int jitter = !(scn->f->flags & VBCL_FRAME_FIXED_FEELERS);
+    float3 wc = ls->to_c / ls->d;
+    float sin_max = r / ls->d;
+    if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
+        sc->skipped += strata * strata;
+        return (float3)(0.0f);
+    }
+    float omega = light_cap_solid_angle(r, ls->d);
+    float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
+    float3 tx, ty;
+    vb_frame(wc, &tx, &ty);
+    float3 sum_cos = (float3)(0.0f);
+#ifdef VBCL_HAS_SPECULAR
+    float3 sum_s = (float3)(0.0f);
+#endif
+    for (uint i = 0; i < strata; i++) {
+        for (uint j = 0; j < strata; j++) {
+            float3 w = light_cap_direction(i, j, strata, key, jitter, one_minus_cos, tx, ty, wc);
+            float cos_n = dot(sp->ns, w);
+            if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
+                sc->skipped++;
+                continue;
+            }
+            /* distance to the near side of the light sphere along w */
+            float b = dot(w, ls->to_c);
+            float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
+            float t_light = b - sqrt(disc);
+            sc->traced++;
+            float3 vis = light_feeler(scn, sp, ls->origin, w, t_light, tc);
+            if (vb_max3(vis) <= 0.0f) continue;
+            sum_cos += vis * cos_n;
+#ifdef VBCL_HAS_SPECULAR
+            float3 hv = normalize(w + sp->wo);
+            float nh = dot(sp->ns, hv);
+            if (nh > ls->nh_min) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
+#endif
+        }
+    }
+    float scale = omega / (float)(strata * strata);
+    float3 sum_d = ls->kd * (sum_cos * scale);
+#ifdef VBCL_HAS_SPECULAR
+    sum_d += ls->ks * (ls->spec_norm * sum_s * scale);
+#endif
+    return radiance * sum_d;
+}
+#endif
+
 /* Reflected radiance toward wo from one light: the cap of the light sphere visible from
  * the point is sampled at strata^2 stratified directions (jittered inside their strata, or
  * at the strata's centres with VBCL_FRAME_FIXED_FEELERS); each direction's feeler is
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
- * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. */
+ * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. A light
+ * of radius 0 is a point light. */
 VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *light,
                                    __global const VbMaterial *m, float3 diffuse,
                                    const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
@@ -81,95 +158,47 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     float3 c = vb_gload3(light->centre);
     float3 radiance = vb_gload3(light->radiance);
     float r = light->radius;
-    float3 to_c = c - sp->p;
-    float d2 = dot(to_c, to_c);
-    float d = sqrt(d2);
-    float3 kd = diffuse * (1.0f / VB_PI);
+    LightShading ls;
+    ls.to_c = c - sp->p;
+    ls.d2 = dot(ls.to_c, ls.to_c);
+    ls.d = sqrt(ls.d2);
+    ls.kd = diffuse * (1.0f / VB_PI);
 #ifdef VBCL_HAS_SPECULAR
-    float3 ks = vb_gload3(m->specular);
-    float spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
-    /* (N.H)^n < 1e-4 below this cosine: such samples skip the costly pow */
-    float nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
+    ls.ks = vb_gload3(m->specular);
+    ls.exponent = m->exponent;
+    ls.spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
+    ls.nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
+#else
+    (void)m;
 #endif
-    float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
-    uint strata = scn->f->shadow_strata;
-    int jitter = !(scn->f->flags & VBCL_FRAME_FIXED_FEELERS);
-
+    ls.origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
 #ifdef VBCL_HAS_AREA_LIGHTS
     if (r > 0.0f) {
-        if (d <= r * 1.0001f) { /* inside the light: lit from every direction, no shadow */
-            return radiance * VB_PI * kd;
+        if (ls.d <= r * 1.0001f) { /* inside the light: lit from every direction, no shadow */
+            return radiance * VB_PI * ls.kd;
         }
-        float3 wc = to_c / d;
-        float sin_max = r / d;
-        if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
-            sc->skipped += strata * strata;
-            return (float3)(0.0f);
-        }
-        float omega = light_cap_solid_angle(r, d);
-        float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
-        float3 tx, ty;
-        vb_frame(wc, &tx, &ty);
-        float3 sum_d = (float3)(0.0f);
-        float3 sum_cos = (float3)(0.0f);
-#ifdef VBCL_HAS_SPECULAR
-        float3 sum_s = (float3)(0.0f);
-#endif
-        for (uint i = 0; i < strata; i++) {
-            for (uint j = 0; j < strata; j++) {
-                uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
-                float u1 = ((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata;
-                float u2 = ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata;
-                float cos_t = 1.0f - u1 * one_minus_cos;
-                float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
-                float phi = 2.0f * VB_PI * u2;
-                float3 w =
-                    normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
-                float cos_n = dot(sp->ns, w);
-                if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
-                    sc->skipped++;
-                    continue;
-                }
-                /* distance to the near side of the light sphere along w */
-                float b = dot(w, to_c);
-                float disc = fmax(0.0f, b * b - (d2 - r * r));
-                float t_light = b - sqrt(disc);
-                sc->traced++;
-                float3 vis = light_feeler(scn, sp, origin, w, t_light, tc);
-                if (vb_max3(vis) <= 0.0f) continue;
-                sum_cos += vis * cos_n;
-#ifdef VBCL_HAS_SPECULAR
-                float3 hv = normalize(w + sp->wo);
-                float nh = dot(sp->ns, hv);
-                if (nh > nh_min) sum_s += vis * (powr(nh, m->exponent) * cos_n);
-#endif
-            }
-        }
-        float scale = omega / (float)(strata * strata);
-        sum_d = kd * (sum_cos * scale);
-#ifdef VBCL_HAS_SPECULAR
-        sum_d += ks * (spec_norm * sum_s * scale);
-#endif
-        return radiance * sum_d;
+        return light_reflect_area(scn, sp, &ls, radiance, r, key, tc, sc);
     }
+#else
+    (void)key;
 #endif
     /* a point light: radiance holds the intensity (W/sr) */
-    float3 w = to_c / d;
+    float3 w = ls.to_c / ls.d;
     float cos_n = dot(sp->ns, w);
     if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
         sc->skipped++;
         return (float3)(0.0f);
     }
     sc->traced++;
-    float3 vis = light_feeler(scn, sp, origin, w, d, tc);
+    float3 vis = light_feeler(scn, sp, ls.origin, w, ls.d, tc);
     if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
-    float3 brdf = kd;
+    float3 brdf = ls.kd;
 #ifdef VBCL_HAS_SPECULAR
     float3 hv = normalize(w + sp->wo);
     float nh = dot(sp->ns, hv);
-    if (nh > nh_min) brdf += ks * (spec_norm * powr(nh, m->exponent));
+    if (nh > ls.nh_min) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
 #endif
-    return radiance * brdf * vis * (cos_n / d2);
+    return radiance * brdf * vis * (cos_n / ls.d2);
 }
 
 /* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):
@@ -186,3 +215,5 @@ VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, Tr
                                  vb_hash(sp->key * 0x27d4eb2fu + l), tc, sc);
     return m->k_local * col;
 }
+
+#endif

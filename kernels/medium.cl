@@ -5,6 +5,11 @@
  * when the effective material changes; any other crossing is passed through. So texture
  * geometry exists only inside its host, a host surface cut by an element has the
  * element's material, and overlapping elements form a union without inner faces. */
+#ifndef VBCL_MEDIUM_CL
+#define VBCL_MEDIUM_CL
+
+#include "optics.cl"
+#include "scene.cl"
 
 /* The effective material where the medium state says the ray is. */
 VB_INLINE uint medium_material(const DevScene *sc, VbMedium m)
@@ -176,3 +181,5 @@ VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, float3 org, flo
     }
     return (float3)(0.0f);
 }
+
+#endif

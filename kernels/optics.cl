@@ -2,6 +2,10 @@
 /* optics.cl — directions and energy at an interface between two dielectrics (thesis
  * 3.1–3.3): vector Snell's law (eq. 4, 6), reflection (eq. 8), total internal reflection
  * (eq. 10), and the split of energy by the Fresnel equations or by thesis eq. 9. */
+#ifndef VBCL_OPTICS_CL
+#define VBCL_OPTICS_CL
+
+#include "compat.h"
 
 /* Mirror direction of d about the unit normal n (either orientation): eq. 8. */
 VB_INLINE float3 optics_reflect(float3 d, float3 n)
@@ -98,3 +102,5 @@ VB_INLINE float optics_transmitted_fraction(float3 d, float3 ng, float eta1, flo
     return optics_fresnel_transmit(eta1, eta2, ci, cos_t);
 #endif
 }
+
+#endif

@@ -2,6 +2,10 @@
 /* probe.cl — kernels for the tests only (built with -DVBCL_TEST_KERNELS): brute-force
  * closest hit, the layout of the shared structs as the device sees it, and local
  * shading at arbitrary points for analytic checks. */
+#ifndef VBCL_PROBE_CL
+#define VBCL_PROBE_CL
+
+#include "render.cl"
 
 /* rays -> hits by testing every triangle: the reference for the grid. */
 __kernel void probe_intersect_brute(__global const VbTriangle *tris, uint ntris,
@@ -44,17 +48,10 @@ __kernel void probe_layout(__global uint *out)
 }
 
 /* The scene arguments every frame kernel starts with, for probes that shade. */
-#define PROBE_SCENE_ARGS                                                                           \
-    __constant const VbFrame *f, __global const VbTriangle *tris,                                  \
-        __global const VbTriNormals *normals, __global const uint *cell_start,                     \
-        __global const uint *cell_tris, __global const VbMaterial *materials,                      \
-        __global const VbObject *objects, __global const VbLight *lights,                          \
-        __global const VbPattern *patterns, __global const float *texels
-
 /* points (xyz + unused), normals (xyz + band + 1: 0 for white) -> radiance: local shading of
  * material 0 at given points with given normals, seen from along the normal, in the
  * camera's medium, by a ray of the given wavelength band. */
-__kernel void probe_shade_points(PROBE_SCENE_ARGS, __global const float *points,
+__kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
                                  __global const float *pnormals, int npoints,
                                  __global float *radiance)
 {
@@ -109,7 +106,7 @@ __kernel void probe_hit_matrix(__global const VbTriangle *tris, uint ntris,
 }
 
 /* points (xyz + unused) -> colours: material `material`'s surface pattern at each point. */
-__kernel void probe_pattern(PROBE_SCENE_ARGS, int material, __global const float *points,
+__kernel void probe_pattern(SCENE_KERNEL_ARGS int material, __global const float *points,
                             int npoints, __global float *out)
 {
     int i = get_global_id(0);
@@ -123,7 +120,7 @@ __kernel void probe_pattern(PROBE_SCENE_ARGS, int material, __global const float
 /* ray (org xyz, dir xyz) -> the rays of its tree that leave the scene, 8 floats each:
  * (dir xyz, band; weight rgb, depth), at most cap of them; *count gets how many left.
  * The same tree as tree_trace_secondary, from a ray of the test's choosing. */
-__kernel void probe_tree_exits(PROBE_SCENE_ARGS, __global const float *ray, int cap,
+__kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int cap,
                                __global float *out, __global int *count)
 {
     if (get_global_id(0) != 0) return;
@@ -159,4 +156,6 @@ __kernel void probe_tree_exits(PROBE_SCENE_ARGS, __global const float *ray, int 
     }
     *count = k;
 }
+#endif
+
 #endif

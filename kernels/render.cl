@@ -15,33 +15,23 @@
  * other aa_* kernels take only their own buffers), are
  * thin — index, bounds guard, device functions — and the host concatenates these files. */
 
-#include "types.h"
-#include "geometry.cl"
-#include "grid.cl"
-#include "scene.cl"
-#include "optics.cl"
-#include "medium.cl"
-#include "light.cl"
-#include "tree.cl"
+#ifndef VBCL_RENDER_CL
+#define VBCL_RENDER_CL
+
 #include "aa.cl"
+#include "light.cl"
+#include "medium.cl"
+#include "scene.cl"
+#include "tree.cl"
 
 #if defined(VBCL_HAS_TRANSPARENCY) || defined(VBCL_HAS_TEXTURES)
 #define VBCL_HAS_MEDIA 1 /* rays track the medium they are in */
 #endif
 
+/* The arguments every frame kernel takes: the scene's, then the ray batch's. */
 #define FRAME_KERNEL_ARGS                                                                          \
-    __constant const VbFrame *f, __global const VbTriangle *tris,                                  \
-        __global const VbTriNormals *normals, __global const uint *cell_start,                     \
-        __global const uint *cell_tris, __global const VbMaterial *materials,                      \
-        __global const VbObject *objects, __global const VbLight *lights,                          \
-        __global const VbPattern *patterns, __global const float *texels, __global VbRay *rays,    \
-        int nrays, __global VbHit *hits, __global VbMedium *media, __global float *radiance,       \
-        __global uint *counters
-
-#define DEV_SCENE                                                                                  \
-    {                                                                                              \
-        f, tris, normals, cell_start, cell_tris, materials, objects, lights, patterns, texels      \
-    }
+    SCENE_KERNEL_ARGS __global VbRay *rays, int nrays, __global VbHit *hits,                       \
+        __global VbMedium *media, __global float *radiance, __global uint *counters
 
 /* Primary ray through the continuous image position (px, py), in pixels from the
  * top-left corner. */
@@ -376,4 +366,6 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const uint 
 
 #ifdef VBCL_TEST_KERNELS
 #include "probe.cl"
+#endif
+
 #endif

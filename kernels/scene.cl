@@ -1,19 +1,26 @@
 #line 2 "scene.cl"
 /* scene.cl — the scene as device functions see it: one bundle of the frame's buffers,
  * passed by pointer instead of eight arguments to every function. */
+#ifndef VBCL_SCENE_CL
+#define VBCL_SCENE_CL
+
+#include "grid.cl"
+
+#define VB_SCENE_FIELD(space, type, name, field) space const type *name;
+#define VB_SCENE_PARAM(space, type, name, field) space const type *name,
+#define VB_SCENE_INIT(space, type, name, field)  name,
 
 typedef struct DevScene {
-    __constant const VbFrame *f;
-    __global const VbTriangle *tris;
-    __global const VbTriNormals *normals;
-    __global const uint *cell_start;
-    __global const uint *cell_tris;
-    __global const VbMaterial *materials;
-    __global const VbObject *objects;
-    __global const VbLight *lights;
-    __global const VbPattern *patterns;
-    __global const float *texels; /* projected images, 4 floats per texel */
+    VBCL_SCENE_BUFFERS(VB_SCENE_FIELD)
 } DevScene;
+
+/* The scene arguments every frame kernel and scene probe starts with (a trailing comma
+ * included: `__kernel void k(SCENE_KERNEL_ARGS int n)`), and the DevScene made of them. */
+#define SCENE_KERNEL_ARGS VBCL_SCENE_BUFFERS(VB_SCENE_PARAM)
+#define DEV_SCENE                                                                                  \
+    {                                                                                              \
+        VBCL_SCENE_BUFFERS(VB_SCENE_INIT)                                                          \
+    }
 
 /* The colour a material's surface pattern gives at point p (1 without a pattern):
  * max(G, 0) for Fourier synthesis, the image's texel for an orthogonal projection (0
@@ -59,3 +66,5 @@ VB_INLINE uint scene_tri_material(const DevScene *sc, int tri)
 {
     return sc->objects[tri_tag(sc->tris, tri) & ~VBCL_TAG_FLAGS].material;
 }
+
+#endif

@@ -4,6 +4,12 @@
  * k_global times R and T, attenuated by absorption along their way; bounded by
  * max_depth (frame, run time) and pruned when a branch's weight is below min_weight in every
  * channel, so a branch that cannot change the pixel is not traced. */
+#ifndef VBCL_TREE_CL
+#define VBCL_TREE_CL
+
+#include "light.cl"
+#include "medium.cl"
+#include "optics.cl"
 
 /* Depth-first with at most one pending sibling per level: max_depth + 1 entries suffice.
  * The host compiles the stack for the next size class (8, 16, 32, 64) above the scene's
@@ -167,3 +173,5 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
                   wg * (s.T * tin), c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1,
                   band);
 }
+
+#endif

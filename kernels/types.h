@@ -299,4 +299,21 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 32, aapass_first);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, seg_offset) == 48, aapass_seg_offset);
 
+/* The scene's buffers, the one list behind every place that names them: the arguments
+ * every frame kernel and scene probe starts with, in this order (render.cl
+ * SCENE_KERNEL_ARGS), the device functions' DevScene (scene.cl), and the host's cl_mem
+ * fields and clSetKernelArg calls (host/render.h, render.c). Each entry is
+ * X(address space, element type, kernel argument name, Renderer field). */
+#define VBCL_SCENE_BUFFERS(X)                                                                      \
+    X(__constant, VbFrame, f, frame)                                                               \
+    X(__global, VbTriangle, tris, tris)                                                            \
+    X(__global, VbTriNormals, normals, normals)                                                    \
+    X(__global, uint, cell_start, cell_start)                                                      \
+    X(__global, uint, cell_tris, cell_tris)                                                        \
+    X(__global, VbMaterial, materials, materials)                                                  \
+    X(__global, VbObject, objects, objects)                                                        \
+    X(__global, VbLight, lights, lights)                                                           \
+    X(__global, VbPattern, patterns, patterns)                                                     \
+    X(__global, float, texels, texels) /* projected images, 4 floats per texel */
+
 #endif

@@ -31,8 +31,8 @@ int fixture_open(Fixture *fx, const char *json)
         return -1;
     }
     /* the frame buffer normally written per tile */
-    if (clEnqueueWriteBuffer(d->queue, fx->r.frame, CL_TRUE, 0, sizeof(VbFrame), &fx->r.frame_host,
-                             0, NULL, NULL) != CL_SUCCESS) {
+    if (clEnqueueWriteBuffer(d->queue, fx->r.buf.frame, CL_TRUE, 0, sizeof(VbFrame),
+                             &fx->r.frame_host, 0, NULL, NULL) != CL_SUCCESS) {
         CHECK(0, "frame upload failed");
         return -1;
     }
@@ -113,10 +113,10 @@ int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const 
     cl_kernel k = clCreateKernel(fx->r.program, name, &rc);
     CHECK(rc == CL_SUCCESS, "clCreateKernel(%s): %s", name, clu_error_name(rc));
     if (rc != CL_SUCCESS) return -1;
-    CHECK(renderer_set_scene_args(&fx->r, k) == 0, "scene arguments: %s", clu_error());
+    CHECK(scene_buffers_set_args(&fx->r.buf, k) == 0, "scene arguments: %s", clu_error());
     for (int i = 0; i < nargs; i++) {
-        rc = clSetKernelArg(k, (cl_uint)(RENDER_SCENE_ARGS + i), sizes[i], vals[i]);
-        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, RENDER_SCENE_ARGS + i,
+        rc = clSetKernelArg(k, (cl_uint)(SCENE_BUFFER_ARGS + i), sizes[i], vals[i]);
+        CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, SCENE_BUFFER_ARGS + i,
               clu_error_name(rc));
     }
     size_t global = (n + 63) / 64 * 64;

@@ -21,7 +21,7 @@ cl_mem buffer(const void *data, size_t bytes);
 int run_kernel(cl_program prog, const char *name, size_t n, int nargs, const size_t *sizes,
                const void *const *vals);
 void read_buffer(cl_mem m, void *dst, size_t bytes);
-/* Runs a probe that starts with the scene arguments (PROBE_SCENE_ARGS), followed by
+/* Runs a probe that starts with the scene arguments (SCENE_KERNEL_ARGS), followed by
  * nargs arguments of its own. */
 int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const size_t *sizes,
                       const void *const *vals);

@@ -100,7 +100,7 @@ static void compare_grid_brute(const char *label, const char *json, const char *
     cl_uint ntris = fx.s.mesh.ntris;
     const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
                          sizeof(cl_mem)};
-    const void *v[] = {&fx.r.tris, &ntris, &mr, &n, &mb};
+    const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &n, &mb};
     run_kernel(fx.r.program, "probe_intersect_brute", (size_t)n, 5, sz, v);
     read_buffer(mg, hg, sizeof *hg * (size_t)n);
     read_buffer(mb, hb, sizeof *hb * (size_t)n);
@@ -202,7 +202,7 @@ static void test_contact_opaque_surface_first(void)
         int n = N;
         const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
                              sizeof(cl_mem)};
-        const void *v[] = {&fx.r.tris, &ntris, &mr, &n, &mb};
+        const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &n, &mb};
         run_kernel(fx.r.program, "probe_intersect_brute", N, 5, sz, v);
         read_buffer(mg, hg, sizeof *hg * N);
         read_buffer(mb, hb, sizeof *hb * N);

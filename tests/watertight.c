@@ -138,7 +138,7 @@ static int tracer_trace(Tracer *tr, const VbRay *rays, int n, VbHit *hits, int b
     cl_kernel k = brute ? tr->brute : tr->r.k_intersect;
     cl_uint ntris = tr->r.frame_host.ntris;
     if (brute) {
-        const void *v[] = {&tr->r.tris, &ntris, &tr->rays, &n, &tr->hits};
+        const void *v[] = {&tr->r.buf.tris, &ntris, &tr->rays, &n, &tr->hits};
         const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
                              sizeof(cl_mem)};
         for (cl_uint i = 0; i < 5 && rc == CL_SUCCESS; i++) rc = clSetKernelArg(k, i, sz[i], v[i]);
@@ -183,7 +183,7 @@ static int tracer_open(Tracer *tr, VbDevice *d, const Scene *s, char *err, size_
         memset(&tr->r, 0, sizeof tr->r);
         return -1;
     }
-    cl_int rc = clEnqueueWriteBuffer(d->queue, tr->r.frame, CL_TRUE, 0, sizeof(VbFrame),
+    cl_int rc = clEnqueueWriteBuffer(d->queue, tr->r.buf.frame, CL_TRUE, 0, sizeof(VbFrame),
                                      &tr->r.frame_host, 0, NULL, NULL);
     cl_int rc2, rc3, rc4, rc5;
     tr->brute = clCreateKernel(tr->r.program, "probe_intersect_brute", &rc2);

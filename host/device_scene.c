@@ -1,0 +1,335 @@
+/* device_scene.c — the scene into the kernels' layout and onto the device: triangles with
+ * their tags, smooth normals, grid cells, materials, objects, lights, surface patterns
+ * (Fourier coefficients and projected images), dispersion band tables, frame constants. */
+#include "device_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dispersion.h"
+#include "kernel_features.h"
+#include "texgen.h"
+
+/* Fills the camera of the frame from the scene's eye, look_at, up and fov. */
+static void frame_camera(const Scene *s, VbCamera *c)
+{
+    vec3 fwd = v3_norm(v3_sub(s->look_at, s->eye));
+    vec3 right = v3_norm(v3_cross(fwd, s->up));
+    vec3 up = v3_cross(right, fwd);
+    float th = tanf(s->fov * 0.5f * (float)(M_PI / 180.0));
+    float aspect = (float)s->width / (float)s->height;
+    right = v3_scale(right, th * aspect);
+    up = v3_scale(up, th);
+    float *dst[4] = {c->eye, c->forward, c->right, c->up};
+    vec3 src[4] = {s->eye, fwd, right, up};
+    for (int i = 0; i < 4; i++) {
+        dst[i][0] = src[i].x;
+        dst[i][1] = src[i].y;
+        dst[i][2] = src[i].z;
+        dst[i][3] = 0.0f;
+    }
+}
+
+static void frame_grid(const Grid *g, VbGrid *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int i = 0; i < 3; i++) {
+        out->lo[i] = g->lo[i];
+        out->hi[i] = g->hi[i];
+        out->cell[i] = g->cell[i];
+        out->inv_cell[i] = 1.0f / g->cell[i];
+        out->n[i] = g->n[i];
+    }
+}
+
+/* Triangles as the kernels read them, the tag in the w of the first vertex. */
+static VbTriangle *pack_triangles(const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    VbTriangle *t = calloc(m->ntris, sizeof *t);
+    if (!t) return NULL;
+    for (uint32_t i = 0; i < m->ntris; i++) {
+        float *dst[3] = {t[i].v0, t[i].v1, t[i].v2};
+        for (int k = 0; k < 3; k++) {
+            vec3 p = m->verts[m->tris[3 * i + k]];
+            dst[k][0] = p.x;
+            dst[k][1] = p.y;
+            dst[k][2] = p.z;
+        }
+        memcpy(&t[i].v0[3], &s->tri_tag[i], sizeof(uint32_t));
+    }
+    return t;
+}
+
+static VbTriNormals *pack_normals(const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    VbTriNormals *t = calloc(m->ntris ? m->ntris : 1, sizeof *t);
+    if (!t || !m->normals) return t;
+    for (uint32_t i = 0; i < m->ntris; i++) {
+        float *dst[3] = {t[i].n0, t[i].n1, t[i].n2};
+        for (int k = 0; k < 3; k++) {
+            vec3 n = m->normals[m->tris[3 * i + k]];
+            dst[k][0] = n.x;
+            dst[k][1] = n.y;
+            dst[k][2] = n.z;
+        }
+    }
+    return t;
+}
+
+/* The texels buffer under construction: projected images, then the band tables. */
+typedef struct Texels {
+    float *v;
+    size_t n; /* in texels of 4 floats */
+} Texels;
+
+/* Makes room for more texels; returns the first new one, or NULL (out of memory). */
+static float *texels_grow(Texels *t, size_t more)
+{
+    float *grown = realloc(t->v, sizeof(float) * 4 * (t->n + more));
+    if (!grown) return NULL;
+    t->v = grown;
+    float *first = grown + 4 * t->n;
+    t->n += more;
+    return first;
+}
+
+/* Material i's surface pattern into pt (images appended to tx). Returns 0, or 2 (the
+ * pattern cannot be made, the message naming the material) or 1 (out of memory). */
+static int pattern_make(const Scene *s, int i, VbPattern *pt, Texels *tx, char *err, size_t errlen)
+{
+    const ScenePattern *sp = &s->materials[i].pattern;
+    char perr[512];
+    pt->kind = sp->kind;
+    for (int k = 0; k < 3; k++) {
+        pt->origin[k] = sp->origin[k];
+        pt->inv_size[k] = 1.0f / sp->size[k];
+    }
+    if (sp->kind == VBCL_PATTERN_FOURIER) {
+        if (!texgen_fourier_init(&pt->fourier, sp->terms, sp->contrast, sp->freq, sp->seed, perr,
+                                 sizeof perr))
+            return 0;
+        snprintf(err, errlen, "%s: materials.%s.pattern: %s", s->path, s->materials[i].name, perr);
+        return 2;
+    }
+    int w, h, rc = 0;
+    float *img = NULL;
+    if (texgen_projection_load(sp->image, &w, &h, &img, perr, sizeof perr)) {
+        snprintf(err, errlen, "%s: materials.%s.pattern.image: %s", s->path, s->materials[i].name,
+                 perr);
+        return 2;
+    }
+    size_t first = tx->n;
+    float *dst = texels_grow(tx, (size_t)w * (size_t)h);
+    if (!dst) {
+        rc = 1;
+        snprintf(err, errlen, "out of memory for the image %s", sp->image);
+    } else {
+        memcpy(dst, img, sizeof(float) * 4 * (size_t)w * (size_t)h);
+        pt->width = w;
+        pt->height = h;
+        pt->texel_offset = (unsigned)first;
+    }
+    free(img);
+    return rc;
+}
+
+/* The side data after the images: the bands' rgb weights (their first float's index into
+ * *band_weights), then per dispersive material its band table (eta, transmitted fraction)
+ * at each band's centre, its index into mats[i].disp. Returns 0, or 1 (out of memory). */
+static int band_tables_make(const Scene *s, VbMaterial *mats, Texels *tx, unsigned *band_weights,
+                            char *err, size_t errlen)
+{
+    int nb = s->bands, ndisp = 0;
+    for (int i = 0; i < s->nmaterials; i++) ndisp += mats[i].disp >= 0;
+    size_t first = tx->n;
+    float *t = texels_grow(tx, (size_t)nb * (size_t)(1 + ndisp));
+    if (!t) {
+        snprintf(err, errlen, "out of memory for the band tables");
+        return 1;
+    }
+    DispBand band[DISP_MAX_BANDS];
+    disp_layout_bands(s->band_layout, nb, band);
+    *band_weights = (unsigned)(4 * first);
+    for (int b = 0; b < nb; b++, t += 4) {
+        memcpy(t, band[b].rgb, sizeof band[b].rgb);
+        t[3] = (float)band[b].centre;
+    }
+    for (int i = 0; i < s->nmaterials; i++) {
+        if (mats[i].disp < 0) continue;
+        const DispModel *d = &s->materials[i].disp;
+        mats[i].disp = (int)(t - tx->v);
+        for (int b = 0; b < nb; b++, t += 4) {
+            t[0] = (float)disp_eta(d, band[b].centre);
+            t[1] = (float)disp_band_transmit(d, band[b].lo, band[b].hi);
+            t[2] = t[3] = 0.0f;
+        }
+    }
+    return 0;
+}
+
+/* Builds the materials' surface patterns and, with dispersion, the band tables, and
+ * uploads them into b->patterns and b->texels; sets mats[i].pattern and mats[i].disp.
+ * Returns 0, 2 (a pattern the scene cannot have, the message naming the material) or 1
+ * (device, out of memory). */
+static int upload_patterns(SceneBuffers *b, VbDevice *dev, const Scene *s, unsigned features,
+                           VbMaterial *mats, unsigned *band_weights, char *err, size_t errlen)
+{
+    VbPattern *pats = calloc((size_t)s->nmaterials + 1, sizeof *pats);
+    Texels tx = {NULL, 0};
+    int npats = 0, rc = 0;
+    if (!pats) return 1;
+    for (int i = 0; i < s->nmaterials && !rc; i++) {
+        if (!s->materials[i].pattern.kind) continue;
+        rc = pattern_make(s, i, &pats[npats], &tx, err, errlen);
+        mats[i].pattern = npats++;
+    }
+    if (!rc && (features & VBCL_FEATURE_DISPERSION)) {
+        rc = band_tables_make(s, mats, &tx, band_weights, err, errlen);
+    } else {
+        for (int i = 0; i < s->nmaterials; i++) mats[i].disp = -1;
+    }
+    if (!rc) {
+        b->patterns = clu_buffer(dev, pats, sizeof *pats * (size_t)npats, CL_MEM_READ_ONLY);
+        b->texels = clu_buffer(dev, tx.v, sizeof(float) * 4 * tx.n, CL_MEM_READ_ONLY);
+        if (!b->patterns || !b->texels) {
+            snprintf(err, errlen, "%s: %s", dev->name, clu_error());
+            rc = 1;
+        }
+    }
+    free(pats);
+    free(tx.v);
+    return rc;
+}
+
+/* Triangles, smooth normals (with VBCL_FEATURE_SMOOTH_NORMALS) and grid cells. Returns 0,
+ * 1 (out of memory, device) or 2 (larger than one allocation). */
+static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const Grid *g,
+                           unsigned features, char *err, size_t errlen)
+{
+    size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
+    if (nbytes_tris > dev->max_alloc || sizeof(uint32_t) * (size_t)g->nrefs > dev->max_alloc) {
+        snprintf(err, errlen,
+                 "%s: the scene (%u triangles, %u grid references) does not fit in "
+                 "one allocation on %s (%.0f MiB at most)",
+                 s->path, s->mesh.ntris, g->nrefs, dev->name, (double)dev->max_alloc / 1048576.0);
+        return 2;
+    }
+    VbTriangle *tris = pack_triangles(s);
+    VbTriNormals *normals = pack_normals(s);
+    if (!tris || !normals) {
+        free(tris);
+        free(normals);
+        snprintf(err, errlen, "out of memory packing %u triangles", s->mesh.ntris);
+        return 1;
+    }
+    b->tris = clu_buffer(dev, tris, nbytes_tris, CL_MEM_READ_ONLY);
+    b->normals = clu_buffer(
+        dev, normals,
+        (features & VBCL_FEATURE_SMOOTH_NORMALS) ? sizeof(VbTriNormals) * s->mesh.ntris : 0,
+        CL_MEM_READ_ONLY);
+    free(tris);
+    free(normals);
+    b->cell_start =
+        clu_buffer(dev, g->cell_start, sizeof(uint32_t) * (g->ncells + 1u), CL_MEM_READ_ONLY);
+    b->cell_tris = clu_buffer(dev, g->cell_tris, sizeof(uint32_t) * g->nrefs, CL_MEM_READ_ONLY);
+    if (b->tris && b->normals && b->cell_start && b->cell_tris) return 0;
+    snprintf(err, errlen, "%s: %s", dev->name, clu_error());
+    return 1;
+}
+
+/* Materials (the scene's, then the medium outside every host: vacuum, eta 1), their
+ * patterns and band tables, objects and lights. Returns as upload_patterns. */
+static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsigned features,
+                            unsigned *band_weights, char *err, size_t errlen)
+{
+    VbMaterial *mats = calloc((size_t)s->nmaterials + 1, sizeof *mats);
+    VbObject *objs = calloc((size_t)s->nobjects, sizeof *objs);
+    int rc = 1;
+    snprintf(err, errlen, "out of memory");
+    if (!mats || !objs) goto done;
+    for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
+    mats[s->nmaterials].eta = 1.0f;
+    mats[s->nmaterials].pattern = -1;
+    mats[s->nmaterials].disp = -1;
+    rc = upload_patterns(b, dev, s, features, mats, band_weights, err, errlen);
+    if (rc) goto done;
+    mats[s->nmaterials].k_global = 1.0f;
+    for (int i = 0; i < s->nobjects; i++) {
+        const SceneObject *o = &s->objects[i];
+        objs[i].material = (unsigned)o->material;
+        objs[i].tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
+        objs[i].tex_slot = o->tex_slot;
+        objs[i].flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
+    }
+    b->materials =
+        clu_buffer(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
+    b->objects = clu_buffer(dev, objs, sizeof *objs * (size_t)s->nobjects, CL_MEM_READ_ONLY);
+    b->lights = clu_buffer(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
+    rc = b->materials && b->objects && b->lights ? 0 : 1;
+    if (rc) snprintf(err, errlen, "%s: %s", dev->name, clu_error());
+done:
+    free(mats);
+    free(objs);
+    return rc;
+}
+
+/* The frame constants of s: camera, grid, background, lights, feelers, media, limits. */
+static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbFrame *f)
+{
+    memset(f, 0, sizeof *f);
+    frame_camera(s, &f->camera);
+    frame_grid(g, &f->grid);
+    memcpy(f->background, s->background, sizeof s->background);
+    memcpy(f->ambient, s->ambient, sizeof s->ambient);
+    f->width = s->width;
+    f->height = s->height;
+    f->nlights = (unsigned)s->nlights;
+    f->ntris = s->mesh.ntris;
+    unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
+    f->shadow_strata = strata < 1 ? 1 : strata;
+    f->seed = s->seed;
+    f->flags = s->shadow_jitter ? 0u : VBCL_FRAME_FIXED_FEELERS;
+    scene_medium_at(s, s->eye, &f->camera_medium);
+    f->air_material = (unsigned)s->nmaterials;
+    f->min_weight = s->min_weight;
+    f->max_depth = s->max_depth;
+    f->bands = s->bands;
+    f->band_weights = band_weights;
+}
+
+int scene_buffers_upload(SceneBuffers *b, VbDevice *dev, const Scene *s, const Grid *g,
+                         unsigned features, VbFrame *f, char *err, size_t errlen)
+{
+    memset(b, 0, sizeof *b);
+    unsigned band_weights = 0;
+    int rc = upload_geometry(b, dev, s, g, features, err, errlen);
+    if (!rc) rc = upload_materials(b, dev, s, features, &band_weights, err, errlen);
+    if (rc) return rc;
+    frame_fill(s, g, band_weights, f);
+    b->frame = clu_buffer(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
+    if (b->frame) return 0;
+    snprintf(err, errlen, "%s: %s", dev->name, clu_error());
+    return 1;
+}
+
+int scene_buffers_set_args(const SceneBuffers *b, cl_kernel k)
+{
+#define SCENE_BUFFER_PTR(space, type, name, field) &b->field,
+    const cl_mem *m[SCENE_BUFFER_ARGS] = {VBCL_SCENE_BUFFERS(SCENE_BUFFER_PTR)};
+    for (cl_uint i = 0; i < SCENE_BUFFER_ARGS; i++)
+        if (clu_set_arg(k, i, sizeof(cl_mem), m[i])) return -1;
+    return 0;
+}
+
+void scene_buffers_release(SceneBuffers *b)
+{
+    cl_mem *m[SCENE_BUFFER_ARGS] = {VBCL_SCENE_BUFFERS(SCENE_BUFFER_PTR)};
+#undef SCENE_BUFFER_PTR
+    for (int i = 0; i < SCENE_BUFFER_ARGS; i++)
+        if (*m[i]) CL_WARN(clReleaseMemObject(*m[i]));
+    memset(b, 0, sizeof *b);
+}
