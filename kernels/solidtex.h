@@ -47,6 +47,12 @@ VBCL_STATIC_ASSERT(sizeof(VbFourier) == 16 + 7 * 32, fourier_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFourier, c) == 16, fourier_c);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFourier, pz) == 16 + 6 * 32, fourier_pz);
 
+/* The pattern sums need nothing of what FP_CONTRACT OFF (compat.h) protects, the watertight
+ * edge tests: on the device they keep the compiler's default. */
+#ifdef VBCL_DEVICE
+#pragma OPENCL FP_CONTRACT DEFAULT
+#endif
+
 /* G at texture point (x, y, z); |G| <= 1, and G >= 0 when a0 >= 1. */
 VBST_FN float solidtex_fourier_eval(VB_GLOBAL const VbFourier *f, float x, float y, float z)
 {
@@ -79,5 +85,9 @@ VBST_FN float solidtex_projection_eval(VB_GLOBAL const float *texels, int width,
     int t = solidtex_projection_texel(width, height, x, y);
     return t < 0 ? 0.0f : texels[t * channels + channel];
 }
+
+#ifdef VBCL_DEVICE
+#pragma OPENCL FP_CONTRACT OFF
+#endif
 
 #endif
