@@ -205,24 +205,11 @@ static void format_edge(char *buf, size_t len, vec3 a, vec3 b)
     snprintf(buf, len, "(%g, %g, %g)-(%g, %g, %g)", a.x, a.y, a.z, b.x, b.y, b.z);
 }
 
-int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
+/* The three edges of every triangle, between welded vertices, into edges (3 ntris).
+ * Returns 0, or -1 with the first degenerate triangle named in err. */
+static int collect_edges(const Mesh *m, const uint32_t *canon, Edge *edges, char *err,
+                         size_t errlen)
 {
-    char e[160];
-    if (m->ntris == 0) {
-        snprintf(err, errlen, "no triangles");
-        return -1;
-    }
-    if (m->ntris > (UINT32_MAX >> 1)) {
-        snprintf(err, errlen, "too many triangles to check (%u)", m->ntris);
-        return -1;
-    }
-    int rc = -1;
-    uint32_t *canon = malloc(((size_t)m->nverts + 1) * sizeof *canon);
-    Edge *edges = malloc((size_t)m->ntris * 3 * sizeof *edges);
-    if (!canon || !edges || weld_positions(m, canon) < 0) {
-        snprintf(err, errlen, "out of memory checking the mesh");
-        goto done;
-    }
     size_t ne = 0;
     for (uint32_t i = 0; i < m->ntris; i++) {
         const uint32_t *t = m->tris + (size_t)i * 3;
@@ -231,14 +218,14 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
             if (t[k] >= m->nverts) {
                 snprintf(err, errlen, "triangle %u: vertex index %u out of range (%u vertices)", i,
                          t[k], m->nverts);
-                goto done;
+                return -1;
             }
             w[k] = canon[t[k]];
         }
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
             snprintf(err, errlen, "triangle %u repeats a vertex index (%u, %u, %u)", i, t[0], t[1],
                      t[2]);
-            goto done;
+            return -1;
         }
         if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) {
             vec3 a = m->verts[w[0]], b = m->verts[w[1]], c = m->verts[w[2]];
@@ -246,7 +233,7 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
                      "triangle %u has two corners at the same position: (%g, %g, %g), "
                      "(%g, %g, %g), (%g, %g, %g)",
                      i, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z);
-            goto done;
+            return -1;
         }
         for (int k = 0; k < 3; k++) {
             uint32_t a = w[k], b = w[(k + 1) % 3];
@@ -255,7 +242,14 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
             ed->tri_dir = i * 2 + (a > b);
         }
     }
-    qsort(edges, ne, sizeof *edges, compare_edges);
+    return 0;
+}
+
+/* Checks the sorted edges: each must be used by exactly two triangles, once in each
+ * direction. Returns 0, or -1 with the first bad edge named in err. */
+static int check_edges(const Mesh *m, const Edge *edges, size_t ne, char *err, size_t errlen)
+{
+    char e[160];
     for (size_t s = 0; s < ne;) {
         size_t r = s, fwd = 0;
         while (r < ne && edges[r].key == edges[s].key) fwd += !(edges[r++].tri_dir & 1);
@@ -281,10 +275,31 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
             format_edge(e, sizeof e, m->verts[lo], m->verts[hi]);
             snprintf(err, errlen, "edge %s used by %zu triangles (non-manifold)", e, count);
         }
-        goto done;
+        return -1;
     }
-    rc = 0;
-done:
+    return 0;
+}
+
+int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
+{
+    if (m->ntris == 0) {
+        snprintf(err, errlen, "no triangles");
+        return -1;
+    }
+    if (m->ntris > (UINT32_MAX >> 1)) {
+        snprintf(err, errlen, "too many triangles to check (%u)", m->ntris);
+        return -1;
+    }
+    int rc = -1;
+    uint32_t *canon = malloc(((size_t)m->nverts + 1) * sizeof *canon);
+    Edge *edges = malloc((size_t)m->ntris * 3 * sizeof *edges);
+    if (!canon || !edges || weld_positions(m, canon) < 0) {
+        snprintf(err, errlen, "out of memory checking the mesh");
+    } else if (!collect_edges(m, canon, edges, err, errlen)) {
+        size_t ne = (size_t)m->ntris * 3;
+        qsort(edges, ne, sizeof *edges, compare_edges);
+        rc = check_edges(m, edges, ne, err, errlen);
+    }
     free(canon);
     free(edges);
     return rc;

@@ -301,10 +301,26 @@ static int parse_values(const char *v, float *list, int *n, int *random)
     return *n < 0 ? -1 : 0;
 }
 
+/* The number option a of `texgen deform` sets in p, or NULL. */
+static float *deform_float_field(DeformParams *p, const char *a)
+{
+    const struct {
+        const char *name;
+        float *field;
+    } opts[] = {{"--taper-max", &p->taper_max}, {"--twist-max", &p->twist_max},
+                {"--spacing", &p->spacing},     {"--aspect", &p->aspect},
+                {"--length", &p->length},       {"--tube-radius", &p->tube_radius},
+                {"--wobble", &p->wobble}};
+    for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++)
+        if (!strcmp(a, opts[i].name)) return opts[i].field;
+    return NULL;
+}
+
 static int cmd_deform(int argc, char **argv)
 {
     static const char *M = "deform";
     DeformParams p;
+    float *f;
     deform_defaults(&p);
     const char *out = NULL;
     int taper_given = 0;
@@ -345,18 +361,8 @@ static int cmd_deform(int argc, char **argv)
         } else if (!strcmp(a, "--twist")) {
             if (parse_values(v, p.twist, &p.ntwist, &p.twist_random))
                 return BAD_VALUE(a, v, "T1,T2,... (one per profile), random or none");
-        } else if (!strcmp(a, "--taper-max") || !strcmp(a, "--twist-max") ||
-                   !strcmp(a, "--spacing") || !strcmp(a, "--aspect") || !strcmp(a, "--length") ||
-                   !strcmp(a, "--tube-radius") || !strcmp(a, "--wobble")) {
-            float f;
-            if (parse_float(v, &f)) return BAD_VALUE(a, v, "a number");
-            if (!strcmp(a, "--taper-max")) p.taper_max = f;
-            if (!strcmp(a, "--twist-max")) p.twist_max = f;
-            if (!strcmp(a, "--spacing")) p.spacing = f;
-            if (!strcmp(a, "--aspect")) p.aspect = f;
-            if (!strcmp(a, "--length")) p.length = f;
-            if (!strcmp(a, "--tube-radius")) p.tube_radius = f;
-            if (!strcmp(a, "--wobble")) p.wobble = f;
+        } else if ((f = deform_float_field(&p, a))) {
+            if (parse_float(v, f)) return BAD_VALUE(a, v, "a number");
         } else if (!strcmp(a, "--segments")) {
             if (parse_int(v, 3, 4096, &p.segments)) return BAD_VALUE(a, v, "3 to 4096");
         } else if (!strcmp(a, "--rings")) {

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#define PI_D              3.14159265358979323846
 #define TRIES_PER_ELEMENT 2000
 
 void bomb_defaults(BombParams *p)
@@ -62,7 +61,8 @@ static int unit_element(const BombParams *p, Mesh *m)
     return shape_revolution(m, prof, 4, p->segments, 1);
 }
 
-int texgen_bomb(const BombParams *p, TexSet *out, char *err, size_t errlen)
+/* Checks the parameters' ranges. Returns 0, or -1 with a message in err. */
+static int bomb_check(const BombParams *p, char *err, size_t errlen)
 {
     if (p->count < 1 || p->count > 1000000) {
         snprintf(err, errlen, "--count %d: expected 1 to 1000000 elements", p->count);
@@ -81,6 +81,30 @@ int texgen_bomb(const BombParams *p, TexSet *out, char *err, size_t errlen)
                  p->segments);
         return -1;
     }
+    return 0;
+}
+
+/* A centre for an element of bounding radius br: uniform in the block, and with
+ * --no-overlap away from every element placed so far. Returns 1, or 0 when no try
+ * succeeded. */
+static int bomb_place(const BombParams *p, const TexSet *out, double br, TexRng *rng, double c[3])
+{
+    int placed = 0;
+    for (int tries = 0; tries < TRIES_PER_ELEMENT && !placed; tries++) {
+        for (int a = 0; a < 3; a++) c[a] = p->block * texrng_uniform(rng);
+        placed = 1;
+        for (int j = 0; j < out->count && p->no_overlap && placed; j++) {
+            const float *b = out->bound[j];
+            double dx = c[0] - b[0], dy = c[1] - b[1], dz = c[2] - b[2], rr = br + b[3];
+            if (dx * dx + dy * dy + dz * dz <= rr * rr) placed = 0;
+        }
+    }
+    return placed;
+}
+
+int texgen_bomb(const BombParams *p, TexSet *out, char *err, size_t errlen)
+{
+    if (bomb_check(p, err, errlen)) return -1;
     texset_init(out);
     char f0[32], f1[32], f2[32];
     snprintf(out->params, sizeof out->params,
@@ -108,17 +132,7 @@ int texgen_bomb(const BombParams *p, TexSet *out, char *err, size_t errlen)
         double r = p->size_min + (p->size_max - p->size_min) * texrng_uniform(&rng);
         double br = bound_radius(p->shape, r);
         double c[3];
-        int placed = 0;
-        for (int tries = 0; tries < TRIES_PER_ELEMENT && !placed; tries++) {
-            for (int a = 0; a < 3; a++) c[a] = p->block * texrng_uniform(&rng);
-            placed = 1;
-            for (int j = 0; j < out->count && p->no_overlap && placed; j++) {
-                const float *b = out->bound[j];
-                double dx = c[0] - b[0], dy = c[1] - b[1], dz = c[2] - b[2], rr = br + b[3];
-                if (dx * dx + dy * dy + dz * dz <= rr * rr) placed = 0;
-            }
-        }
-        if (!placed) {
+        if (!bomb_place(p, out, br, &rng, c)) {
             snprintf(err, errlen,
                      "--no-overlap: cannot place element %d of %d (radius %.3g) after %d tries; "
                      "expected fewer or smaller elements, or a larger --block",

@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PI_D         3.14159265358979323846
 #define RING_STEP    (3.0 * PI_D / 180.0) /* at most this much twist between two rings */
 #define MAX_SEGMENTS 4096
 #define MAX_RINGS    4096
@@ -383,11 +382,180 @@ static int ring_count(const DeformParams *p, const Prof *pr, int n)
     return r > MAX_RINGS ? MAX_RINGS : (int)r;
 }
 
+/* The nested profiles' sizes, growth and twists: untwisted, R_i = i C; twisted
+ * rectangles, both edges of i+1 longer than the diagonal of i (g = sqrt(1 + k^2) / k);
+ * twisted circles, the polygon's circumradius over its inradius. Returns 0, or -1 with the
+ * clearance rule's message (thesis 2.2.2.2) in err. */
+static int profiles_nested(const DeformParams *p, const double *a, const double *t, double amax,
+                           int twisted, int segments, Prof *pr, char *err, size_t errlen)
+{
+    const double L = p->length, C = p->spacing, k = p->aspect;
+    double g = 1.0;
+    if (twisted) g = p->rect ? sqrt(1.0 + k * k) / k : 1.0 / cos(PI_D / segments);
+    double lim = 2.0 * g * amax * L;
+    if (!(C > lim)) {
+        snprintf(err, errlen,
+                 "clearance rule violated: --spacing C = %g must exceed 2*g*max|a|*Max_Z = "
+                 "2*%.4g*%.4g*%g = %.4g (thesis 2.2.2.2); expected a larger --spacing, a "
+                 "shorter --length or smaller tapers",
+                 C, g, amax, L, lim);
+        return -1;
+    }
+    double R = C;
+    for (int i = 0; i < p->count; i++) {
+        pr[i].size = R;
+        pr[i].grow = a[i] + (i > 0 ? a[i - 1] : 0.0); /* X_i = (f_i + f_{i-1} + 1) x */
+        pr[i].twist = t[i] * PI_D / 180.0;
+        R = g * R + C;
+    }
+    return 0;
+}
+
+/* The tubes: lane m is the annulus around D_m = (m + 1) C; the tube (radius r + a z,
+ * wobbling by +-w) must stay inside it whatever the twists do. Returns as profiles_nested. */
+static int profiles_tubes(const DeformParams *p, const double *a, const double *t, double amax,
+                          double circ, TexRng *rng, Prof *pr, char *err, size_t errlen)
+{
+    const double L = p->length, C = p->spacing;
+    double rmax = p->tube_radius + amax * L, rmin = p->tube_radius - amax * L;
+    double w = p->wobble * 0.5 * (C - 2.0 * rmax * circ);
+    if (!(rmin > 0) || !(w >= 0) || !(p->wobble >= 0.0f && p->wobble < 1.0f)) {
+        snprintf(err, errlen,
+                 "clearance rule violated: tubes of radius %g +- %.4g (taper over Max_Z) need "
+                 "a positive radius and lanes wider than %.4g (--spacing %g, --wobble %g in "
+                 "[0, 1))",
+                 p->tube_radius, amax * L, 2.0 * rmax * circ, C, p->wobble);
+        return -1;
+    }
+    for (int i = 0; i < p->count; i++) {
+        pr[i].size = p->tube_radius;
+        pr[i].grow = a[i];
+        pr[i].twist = t[i] * PI_D / 180.0;
+        pr[i].orbit = (i + 1) * C;
+        pr[i].angle0 = 2 * PI_D * texrng_uniform(rng);
+        pr[i].wob_amp = w;
+        pr[i].wob_freq = 2 * PI_D * (1 + (int)(3 * texrng_uniform(rng))) / L;
+        pr[i].wob_phase = 2 * PI_D * texrng_uniform(rng);
+    }
+    return 0;
+}
+
+/* The command line that reproduces the set, as its params. */
+static void deform_params_text(const DeformParams *p, int segments, int rings, TexSet *out)
+{
+    char tl[256], wl[256];
+    format_list(tl, sizeof tl, p->taper, p->ntaper, p->taper_random, p->taper_max, "taper");
+    format_list(wl, sizeof wl, p->twist, p->ntwist, p->twist_random, p->twist_max, "twist");
+    char fs[32], fl[32], fa[32];
+    snprintf(out->params, sizeof out->params,
+             "deform --kind %s --profile %s --count %d --spacing %s%s%s --length %s "
+             "--segments %d --rings %d --seed %llu%s%s",
+             p->kind == DEFORM_NESTED ? "nested" : "tubes", p->rect ? "rect" : "circle", p->count,
+             texgen_float_str(fs, sizeof fs, p->spacing), tl, wl,
+             texgen_float_str(fl, sizeof fl, p->length), segments, rings,
+             (unsigned long long)p->seed, p->rect ? " --aspect " : "",
+             p->rect ? texgen_float_str(fa, sizeof fa, p->aspect) : "");
+    if (p->kind == DEFORM_TUBES) {
+        size_t len = strlen(out->params);
+        char fr[32], fw[32];
+        snprintf(out->params + len, sizeof out->params - len, " --tube-radius %s --wobble %s",
+                 texgen_float_str(fr, sizeof fr, p->tube_radius),
+                 texgen_float_str(fw, sizeof fw, p->wobble));
+    }
+}
+
+/* The texture block: out to the farthest any profile reaches from the axis, z over the
+ * length. */
+static void deform_block(const DeformParams *p, const Prof *pr, double circ, TexSet *out)
+{
+    double ext = 0, L = p->length;
+    for (int i = 0; i < p->count; i++) {
+        double r = fmax(prof_size(&pr[i], 0), prof_size(&pr[i], L)) * circ;
+        ext = fmax(ext, pr[i].orbit + pr[i].wob_amp + r);
+    }
+    out->block_lo[0] = out->block_lo[1] = (float)-ext;
+    out->block_hi[0] = out->block_hi[1] = (float)ext;
+    out->block_lo[2] = 0.0f;
+    out->block_hi[2] = (float)L;
+}
+
+/* The elements: the solids (tubes), or the regions inside an odd number of nested
+ * profiles: bands (n-1, n), (n-3, n-2), ..., and the core when n is odd. Returns 0, -3 (a
+ * band's cap folds over) or another negative value (out of memory). */
+static int deform_elements(const DeformParams *p, const Prof *pr, const Shape *s, const double *zs,
+                           int rings, TexSet *out)
+{
+    int rc = 0;
+    for (int hi = p->count - 1; hi >= 0 && rc == 0; hi -= (p->kind == DEFORM_NESTED ? 2 : 1)) {
+        Mesh m;
+        mesh_init(&m);
+        int band = p->kind == DEFORM_NESTED && hi > 0;
+        rc = band ? sweep_band(&m, &pr[hi - 1], &pr[hi], s, zs, rings)
+                  : sweep_solid(&m, &pr[hi], s, zs, rings);
+        if (rc) {
+            mesh_free(&m);
+            break;
+        }
+        vec3 lo, hi3;
+        mesh_bounds(&m, &lo, &hi3);
+        vec3 c = v3_scale(v3_add(lo, hi3), 0.5f);
+        float bound[4] = {c.x, c.y, c.z, v3_len(v3_sub(hi3, c))};
+        if (texset_add(out, &m, bound) < 0) rc = -1;
+    }
+    return rc;
+}
+
+/* Checks that no profile turns more than 45 degrees between two rings. */
+static int check_rings(const Prof *pr, int n, double L, int rings, char *err, size_t errlen)
+{
+    for (int i = 0; i < n; i++)
+        if (fabs(pr[i].twist) * L / rings > PI_D / 4) {
+            snprintf(err, errlen,
+                     "--rings %d: profile %d turns %.4g degrees between rings; expected at most 45 "
+                     "(more --rings, or 0 for automatic)",
+                     rings, i + 1, fabs(pr[i].twist) * L / rings * 180 / PI_D);
+            return -1;
+        }
+    return 0;
+}
+
+/* Sweeps the elements of the set and checks them (disjoint). Returns as texgen_deform. */
+static int deform_sweep(const DeformParams *p, const Prof *pr, const Shape *s, int rings,
+                        TexSet *out, char *err, size_t errlen)
+{
+    double *zs = malloc((size_t)(rings + 1) * sizeof *zs);
+    if (!zs) {
+        snprintf(err, errlen, "out of memory");
+        return -2;
+    }
+    for (int r = 0; r <= rings; r++) zs[r] = p->length * r / rings;
+    int rc = deform_elements(p, pr, s, zs, rings, out);
+    free(zs);
+    if (rc == -3) {
+        snprintf(err, errlen,
+                 "a band's end cap folds over: the profiles are too close for %d segments; "
+                 "expected a larger --spacing or more --segments",
+                 p->segments);
+        return -1;
+    }
+    if (rc) {
+        snprintf(err, errlen, "out of memory");
+        return -2;
+    }
+    if (texset_check_disjoint(out, err, errlen)) {
+        size_t len = strlen(err);
+        snprintf(err + len, errlen - len,
+                 ": the tessellation is too coarse for the deformation; expected more --rings "
+                 "or --segments, or a larger --spacing");
+        return -1;
+    }
+    return 0;
+}
+
 int texgen_deform(const DeformParams *p, TexSet *out, char *err, size_t errlen)
 {
     if (check_common(p, err, errlen)) return -1;
-    int n = p->count, rc = 0;
-    const double L = p->length, C = p->spacing, k = p->aspect;
+    int n = p->count;
     TexRng rng;
     texrng_seed(&rng, p->seed);
     double a[DEFORM_MAX], t[DEFORM_MAX];
@@ -399,154 +567,28 @@ int texgen_deform(const DeformParams *p, TexSet *out, char *err, size_t errlen)
         if (!p->taper_random) amax = fmax(amax, fabs(a[i]));
         if (t[i] != 0.0) twisted = 1;
     }
-
     Shape s;
-    if (shape_make(&s, p->rect, k, p->segments) < 0) {
+    if (shape_make(&s, p->rect, p->aspect, p->segments) < 0) {
         shape_release(&s);
         snprintf(err, errlen, "out of memory");
         return -2;
     }
     /* circumradius over inradius-like ratio of one profile to the next (thesis 2.2.2.2) */
-    double circ = p->rect ? sqrt(1.0 + k * k) : 1.0;
+    double circ = p->rect ? sqrt(1.0 + (double)p->aspect * p->aspect) : 1.0;
     Prof pr[DEFORM_MAX];
     memset(pr, 0, sizeof pr);
-    if (p->kind == DEFORM_NESTED) {
-        /* untwisted: R_i = i C; twisted rectangles: both edges of i+1 longer than the
-         * diagonal of i (g = sqrt(1 + k^2) / k); twisted circles: the polygon's
-         * circumradius over its inradius. */
-        double g = 1.0;
-        if (twisted) g = p->rect ? circ / k : 1.0 / cos(PI_D / s.m);
-        double lim = 2.0 * g * amax * L;
-        if (!(C > lim)) {
-            snprintf(err, errlen,
-                     "clearance rule violated: --spacing C = %g must exceed 2*g*max|a|*Max_Z = "
-                     "2*%.4g*%.4g*%g = %.4g (thesis 2.2.2.2); expected a larger --spacing, a "
-                     "shorter --length or smaller tapers",
-                     C, g, amax, L, lim);
-            shape_release(&s);
-            return -1;
-        }
-        double R = C;
-        for (int i = 0; i < n; i++) {
-            pr[i].size = R;
-            pr[i].grow = a[i] + (i > 0 ? a[i - 1] : 0.0); /* X_i = (f_i + f_{i-1} + 1) x */
-            pr[i].twist = t[i] * PI_D / 180.0;
-            R = g * R + C;
-        }
-    } else {
-        /* tubes: lane m is the annulus around D_m = (m + 1) C; the tube (radius r + a z,
-         * wobbling by +-w) must stay inside it whatever the twists do */
-        double rmax = p->tube_radius + amax * L, rmin = p->tube_radius - amax * L;
-        double w = p->wobble * 0.5 * (C - 2.0 * rmax * circ);
-        if (!(rmin > 0) || !(w >= 0) || !(p->wobble >= 0.0f && p->wobble < 1.0f)) {
-            snprintf(err, errlen,
-                     "clearance rule violated: tubes of radius %g +- %.4g (taper over Max_Z) need "
-                     "a positive radius and lanes wider than %.4g (--spacing %g, --wobble %g in "
-                     "[0, 1))",
-                     p->tube_radius, amax * L, 2.0 * rmax * circ, C, p->wobble);
-            shape_release(&s);
-            return -1;
-        }
-        for (int i = 0; i < n; i++) {
-            pr[i].size = p->tube_radius;
-            pr[i].grow = a[i];
-            pr[i].twist = t[i] * PI_D / 180.0;
-            pr[i].orbit = (i + 1) * C;
-            pr[i].angle0 = 2 * PI_D * texrng_uniform(&rng);
-            pr[i].wob_amp = w;
-            pr[i].wob_freq = 2 * PI_D * (1 + (int)(3 * texrng_uniform(&rng))) / L;
-            pr[i].wob_phase = 2 * PI_D * texrng_uniform(&rng);
-        }
+    int rc = p->kind == DEFORM_NESTED
+                 ? profiles_nested(p, a, t, amax, twisted, s.m, pr, err, errlen)
+                 : profiles_tubes(p, a, t, amax, circ, &rng, pr, err, errlen);
+    int rings = rc ? 0 : ring_count(p, pr, n);
+    if (!rc) rc = check_rings(pr, n, p->length, rings, err, errlen);
+    if (!rc) {
+        texset_init(out);
+        deform_params_text(p, s.m, rings, out);
+        deform_block(p, pr, circ, out);
+        rc = deform_sweep(p, pr, &s, rings, out, err, errlen);
+        if (rc) texset_free(out);
     }
-    int rings = ring_count(p, pr, n);
-    for (int i = 0; i < n; i++)
-        if (fabs(pr[i].twist) * L / rings > PI_D / 4) {
-            snprintf(err, errlen,
-                     "--rings %d: profile %d turns %.4g degrees between rings; expected at most 45 "
-                     "(more --rings, or 0 for automatic)",
-                     rings, i + 1, fabs(pr[i].twist) * L / rings * 180 / PI_D);
-            shape_release(&s);
-            return -1;
-        }
-    double *zs = malloc((size_t)(rings + 1) * sizeof *zs);
-    if (!zs) {
-        shape_release(&s);
-        snprintf(err, errlen, "out of memory");
-        return -2;
-    }
-    for (int r = 0; r <= rings; r++) zs[r] = L * r / rings;
-
-    texset_init(out);
-    char tl[256], wl[256];
-    format_list(tl, sizeof tl, p->taper, p->ntaper, p->taper_random, p->taper_max, "taper");
-    format_list(wl, sizeof wl, p->twist, p->ntwist, p->twist_random, p->twist_max, "twist");
-    char fs[32], fl[32], fa[32];
-    snprintf(out->params, sizeof out->params,
-             "deform --kind %s --profile %s --count %d --spacing %s%s%s --length %s "
-             "--segments %d --rings %d --seed %llu%s%s",
-             p->kind == DEFORM_NESTED ? "nested" : "tubes", p->rect ? "rect" : "circle", n,
-             texgen_float_str(fs, sizeof fs, p->spacing), tl, wl,
-             texgen_float_str(fl, sizeof fl, p->length), s.m, rings, (unsigned long long)p->seed,
-             p->rect ? " --aspect " : "",
-             p->rect ? texgen_float_str(fa, sizeof fa, p->aspect) : "");
-    if (p->kind == DEFORM_TUBES) {
-        size_t len = strlen(out->params);
-        char fr[32], fw[32];
-        snprintf(out->params + len, sizeof out->params - len, " --tube-radius %s --wobble %s",
-                 texgen_float_str(fr, sizeof fr, p->tube_radius),
-                 texgen_float_str(fw, sizeof fw, p->wobble));
-    }
-
-    double ext = 0; /* farthest any profile reaches from the axis */
-    for (int i = 0; i < n; i++) {
-        double r = fmax(prof_size(&pr[i], 0), prof_size(&pr[i], L)) * circ;
-        ext = fmax(ext, pr[i].orbit + pr[i].wob_amp + r);
-    }
-    out->block_lo[0] = out->block_lo[1] = (float)-ext;
-    out->block_hi[0] = out->block_hi[1] = (float)ext;
-    out->block_lo[2] = 0.0f;
-    out->block_hi[2] = (float)L;
-
-    /* elements: the solids (tubes), or the regions inside an odd number of nested
-     * profiles: bands (n-1, n), (n-3, n-2), ..., and the core when n is odd */
-    for (int hi = n - 1; hi >= 0 && rc == 0; hi -= (p->kind == DEFORM_NESTED ? 2 : 1)) {
-        Mesh m;
-        mesh_init(&m);
-        int band = p->kind == DEFORM_NESTED && hi > 0;
-        rc = band ? sweep_band(&m, &pr[hi - 1], &pr[hi], &s, zs, rings)
-                  : sweep_solid(&m, &pr[hi], &s, zs, rings);
-        if (rc) {
-            mesh_free(&m);
-            break;
-        }
-        vec3 lo, hi3;
-        mesh_bounds(&m, &lo, &hi3);
-        vec3 c = v3_scale(v3_add(lo, hi3), 0.5f);
-        float bound[4] = {c.x, c.y, c.z, v3_len(v3_sub(hi3, c))};
-        if (texset_add(out, &m, bound) < 0) rc = -1;
-    }
-    free(zs);
     shape_release(&s);
-    if (rc == -3) {
-        snprintf(err, errlen,
-                 "a band's end cap folds over: the profiles are too close for %d segments; "
-                 "expected a larger --spacing or more --segments",
-                 p->segments);
-        texset_free(out);
-        return -1;
-    }
-    if (rc) {
-        snprintf(err, errlen, "out of memory");
-        texset_free(out);
-        return -2;
-    }
-    if (texset_check_disjoint(out, err, errlen)) {
-        size_t len = strlen(err);
-        snprintf(err + len, errlen - len,
-                 ": the tessellation is too coarse for the deformation; expected more --rings "
-                 "or --segments, or a larger --spacing");
-        texset_free(out);
-        return -1;
-    }
-    return 0;
+    return rc;
 }

@@ -9,8 +9,6 @@
 
 #include "image_io.h"
 
-#define PI_D 3.14159265358979323846
-
 int texgen_fourier_init(VbFourier *f, int n, float a0, const float base_freq[3], uint64_t seed,
                         char *err, size_t errlen)
 {

@@ -4,6 +4,9 @@
 
 #include <math.h>
 
+/* pi in double; M_PI is POSIX, not C99. */
+#define PI_D 3.14159265358979323846
+
 typedef struct vec3 {
     float x, y, z;
 } vec3;
