@@ -11,6 +11,7 @@
 
 #include "aa.h"
 #include "clu.h"
+#include "diag.h"
 #include "kernel_features.h"
 #include "image_io.h"
 #include "render.h"
@@ -75,12 +76,12 @@ static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)
 
 static int usage_error(const char *fmt, ...)
 {
+    char msg[2048];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "vbcl: ");
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, " (see vbcl --help)\n");
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    diag_print("vbcl", "%s (see vbcl --help)", msg);
     return 2;
 }
 
@@ -90,7 +91,8 @@ static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
     errno = 0;
     long v = strtol(s, &end, 10);
     if (end == s || *end || errno || v < lo || v > hi) {
-        fprintf(stderr, "vbcl: %s %s: expected a whole number from %d to %d\n", opt, s, lo, hi);
+        diag_print("vbcl", "%s %s: expected a whole number from %d to %d", opt, diag_value(s), lo,
+                   hi);
         return -1;
     }
     *out = (int)v;
@@ -103,7 +105,8 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
     errno = 0;
     double v = strtod(s, &end);
     if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "vbcl: %s %s: expected a number from %g to %g\n", opt, s, lo, hi);
+        diag_print("vbcl", "%s %s: expected a number from %s to %s", opt, diag_value(s),
+                   diag_num(lo), diag_num(hi));
         return -1;
     }
     *out = v;
@@ -123,7 +126,7 @@ static int parse_args(int argc, char **argv, Options *o)
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
 #define NEEDS_VALUE                                                                                \
     do {                                                                                           \
-        if (!val) return usage_error("%s needs a value", a);                                       \
+        if (!val) return usage_error("%s needs a value", diag_value(a));                           \
         i++;                                                                                       \
     } while (0)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -146,7 +149,7 @@ static int parse_args(int argc, char **argv, Options *o)
                 if (end == b) f1 = -1;
             }
             if (end == val || *end || errno || f0 < 0 || f1 < f0 || f1 > 100000)
-                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", val);
+                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", diag_value(val));
             o->frame_first = (int)f0;
             o->frame_last = (int)f1;
         } else if (!strcmp(a, "--width")) {
@@ -173,7 +176,7 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "--fresnel")) {
             NEEDS_VALUE;
             if (strcmp(val, "exact") && strcmp(val, "thesis"))
-                return usage_error("--fresnel %s: expected exact or thesis", val);
+                return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
             o->fresnel = val;
         } else if (!strcmp(a, "--exposure")) {
             NEEDS_VALUE;
@@ -207,9 +210,9 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
         } else if (a[0] == '-' && a[1]) {
-            return usage_error("unknown option %s", a);
+            return usage_error("unknown option %s", diag_value(a));
         } else if (o->scene) {
-            return usage_error("one scene at a time (also got %s)", a);
+            return usage_error("one scene at a time (also got %s)", diag_value(a));
         } else {
             o->scene = a;
         }
@@ -396,7 +399,8 @@ static int apply_options(const Options *o, Scene *s)
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o->grid && scene_parse_grid(o->grid, s->grid_res))
-        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o->grid);
+        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)",
+                           diag_value(o->grid));
     return 0;
 }
 
@@ -407,7 +411,7 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     char err[1024] = "";
     Scene s;
     if (scene_load_frame(o->scene, frame, &s, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         return 2;
     }
     int rc = apply_options(o, &s);
@@ -424,7 +428,7 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
         goto done_scene;
     }
     if (image_check_path(out, err, sizeof err) || (map && image_check_path(map, err, sizeof err))) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 2;
         goto done_scene;
     }
@@ -436,23 +440,23 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     }
     rc = renderer_init(&r, dev, &s, NULL, &st, err, sizeof err);
     if (rc) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         goto done_renderer;
     }
     int progress = !o->quiet && isatty(STDERR_FILENO);
     if (renderer_render(&r, &s, rgba, &st, progress, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
     double tw = clu_now_ms();
     if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
     if (map && r.aa_levels && write_aa_map(map, &s, r.aa_levels, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
@@ -494,7 +498,7 @@ int main(int argc, char **argv)
     char err[1024] = "";
     Scene s;
     if (scene_load(o.scene, &s, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         return 2;
     }
     int frames = s.frames, animated = s.animated;
@@ -514,7 +518,7 @@ int main(int argc, char **argv)
     const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
     rc = clu_device_open(spec, &dev, err, sizeof err);
     if (rc) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         return rc;
     }
     if (!animated) {

@@ -1,6 +1,8 @@
 /* mesh_io.c — loads triangle meshes from Wavefront OBJ and PLY (ASCII and binary) files. */
 #include "mesh.h"
 
+#include "diag.h"
+
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -20,12 +22,12 @@ typedef struct Ctx {
 static int fail(const Ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int fail(const Ctx *c, const char *fmt, ...)
 {
-    char msg[256];
+    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    snprintf(c->err, c->errlen, "%s%s", c->path, msg);
+    diag_format(c->err, c->errlen, "%s%s", c->path, msg);
     return -1;
 }
 

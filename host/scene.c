@@ -15,6 +15,7 @@
 #include <cJSON.h>
 
 #include "cache.h"
+#include "diag.h"
 #include "grid.h"
 
 #define PATH_MAX_LEN 256
@@ -32,17 +33,15 @@ static int fail(Ctx *c, const char *path, const char *fmt, ...)
 
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
 {
-    char msg[512];
+    char msg[1024];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
     if (path && *path)
-        snprintf(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
+        diag_format(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
     else
-        snprintf(c->err, c->errlen, "%s: %s", c->file, msg);
-    for (char *ch = c->err; *ch; ch++) /* keys and names may hold control characters */
-        if ((unsigned char)*ch < 0x20) *ch = '?';
+        diag_format(c->err, c->errlen, "%s: %s", c->file, msg);
     return -1;
 }
 
@@ -93,6 +92,30 @@ static int check_keys(Ctx *c, const cJSON *obj, const char *path, const char *co
     return 0;
 }
 
+/* The range [lo, hi] as a message shows it: "[1, 16384]", "> 0", ">= 0"; FLT_MIN or
+ * DBL_MIN as lo means an open interval at 0, FLT_MAX or DBL_MAX as hi no upper limit. */
+static const char *range_text(double lo, double hi, char *buf, size_t n)
+{
+    int open = lo == FLT_MIN || lo == DBL_MIN, unbounded = hi == FLT_MAX || hi == DBL_MAX;
+    if (open && unbounded)
+        snprintf(buf, n, "> 0");
+    else if (open)
+        snprintf(buf, n, "> 0 and <= %s", diag_num(hi));
+    else if (unbounded)
+        snprintf(buf, n, ">= %s", diag_num(lo));
+    else
+        snprintf(buf, n, "[%s, %s]", diag_num(lo), diag_num(hi));
+    return buf;
+}
+
+/* The error for a number v outside [lo, hi] at path p. */
+static int fail_range(Ctx *c, const char *p, double v, double lo, double hi)
+{
+    char r[96];
+    range_text(lo, hi, r, sizeof r);
+    return fail(c, p, "%s is out of range%s%s", diag_num(v), r[0] == '[' ? " " : ": expected ", r);
+}
+
 static int expect_object(Ctx *c, const cJSON *j, const char *path)
 {
     if (!cJSON_IsObject(j)) return fail(c, path, "expected an object, got %s", json_type_name(j));
@@ -114,7 +137,7 @@ static int get_num(Ctx *c, const cJSON *obj, const char *path, const char *key, 
     if (!cJSON_IsNumber(j)) return fail(c, p, "expected a number, got %s", json_type_name(j));
     double v = j->valuedouble;
     if (!isfinite(v)) return fail(c, p, "expected a finite number");
-    if (v < lo || v > hi) return fail(c, p, "%g is out of range [%g, %g]", v, lo, hi);
+    if (v < lo || v > hi) return fail_range(c, p, v, lo, hi);
     *out = v;
     return 0;
 }
@@ -155,7 +178,7 @@ static int read_vec(Ctx *c, const cJSON *j, const char *p, int n, double lo, dou
         if (!cJSON_IsNumber(e)) return fail(c, pi, "expected a number, got %s", json_type_name(e));
         if (!isfinite(e->valuedouble)) return fail(c, pi, "expected a finite number");
         if (e->valuedouble < lo || e->valuedouble > hi)
-            return fail(c, pi, "%g is out of range [%g, %g]", e->valuedouble, lo, hi);
+            return fail_range(c, pi, e->valuedouble, lo, hi);
         out[i] = (float)e->valuedouble;
     }
     return 0;
@@ -328,7 +351,7 @@ static int get_bands(Ctx *c, const cJSON *j, Scene *s)
     if (cJSON_IsString(b)) {
         if (strcmp(b->valuestring, "thesis") != 0)
             return fail(c, "render.bands", "expected an integer 1..%d or \"thesis\", got \"%s\"",
-                        DISP_MAX_BANDS, b->valuestring);
+                        DISP_MAX_BANDS, diag_value(b->valuestring));
         s->bands = DISP_THESIS_BANDS;
         s->band_layout = DISP_LAYOUT_THESIS;
         return 0;
@@ -561,7 +584,7 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
         }
     } else {
         return fail(c, q, "expected \"thesis\", \"cauchy\" or \"sellmeier\", got \"%s\"",
-                    model->valuestring);
+                    diag_value(model->valuestring));
     }
     if (cJSON_GetObjectItemCaseSensitive(j, "band")) {
         float band[2], jump;
@@ -800,7 +823,7 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
         path_key(q, p, "shape");
         return fail(c, q,
                     "unknown shape \"%s\" (expected mesh, sphere, box, prism, quad or revolution)",
-                    shape);
+                    diag_value(shape));
     }
     if (rc) return fail(c, p, "could not tessellate the shape (out of memory)");
     return 0;
@@ -898,7 +921,7 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
     if (!mat) return fail(c, q, "missing (expected the name of the texture's material)");
     if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
     *material = find_material(s, mat->valuestring);
-    if (*material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+    if (*material < 0) return fail(c, q, "unknown material \"%s\"", diag_value(mat->valuestring));
     const cJSON *f = cJSON_GetObjectItemCaseSensitive(t, "file");
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(t, "generate");
     char full[4096], merr[512];
@@ -998,7 +1021,8 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     if (!mat) return fail(c, q, "missing (expected the name of a material)");
     if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
     ob->material = find_material(s, mat->valuestring);
-    if (ob->material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+    if (ob->material < 0)
+        return fail(c, q, "unknown material \"%s\"", diag_value(mat->valuestring));
 
     Mesh m, tex;
     mesh_init(&m);
@@ -1172,7 +1196,7 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             return fail(c, path,
                         "\"%s\": expected a value inside image, camera, render, lights, "
                         "materials or objects",
-                        target);
+                        diag_value(target));
         }
         int index = -1;
         cJSON *next = NULL;
@@ -1188,7 +1212,8 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             }
             if (index < 0) {
                 cJSON_Delete(val);
-                return fail(c, path, "\"%s\": no element \"%s\" (an index or a name)", target, seg);
+                return fail(c, path, "\"%s\": no element \"%s\" (an index or a name)",
+                            diag_value(target), diag_value(seg));
             }
             next = cJSON_GetArrayItem(node, index);
             in_element = 1;
@@ -1196,18 +1221,19 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             next = cJSON_GetObjectItemCaseSensitive(node, seg);
             if (!next && node == root) {
                 cJSON_Delete(val);
-                return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+                return fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
+                            diag_value(seg));
             }
         } else {
             cJSON_Delete(val);
-            return fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array", target,
-                        seg, json_type_name(node));
+            return fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array",
+                        diag_value(target), diag_value(seg), json_type_name(node));
         }
         if (last) {
             if (next && !cJSON_IsNumber(next) && !cJSON_IsArray(next)) {
                 cJSON_Delete(val);
                 return fail(c, path, "\"%s\" is a %s: only numbers and arrays of numbers animate",
-                            target, json_type_name(next));
+                            diag_value(target), json_type_name(next));
             }
             if (!val) return 0;
             cJSON_bool ok = index >= 0 ? cJSON_ReplaceItemInArray(node, index, val)
@@ -1221,7 +1247,7 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
         }
         if (!next && !in_element) {
             cJSON_Delete(val);
-            return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+            return fail(c, path, "\"%s\": no member \"%s\"", diag_value(target), diag_value(seg));
         }
         if (!next) {            /* a missing object on the way, inside an element (its transform) */
             if (!val) return 0; /* checking only: it would be created */

@@ -300,12 +300,36 @@ static void test_cli_bad_input_classes(void)
           "missing scene: %s", out);
 }
 
+/* Control characters in a file name, an argument or a key appear as \xNN, and a huge
+ * value is cut: every message stays one harmless line (issue 17). */
+static void test_cli_messages_escaped(void)
+{
+    char cmd[2048], out[8192];
+    snprintf(cmd, sizeof cmd, "%s \"$(printf '%s/a\\nb\\033[31m.json')\"", tu_vbcl, tu_tmpdir());
+    int rc = tu_run(cmd, out, sizeof out);
+    char *nl = strchr(out, '\n');
+    CHECK(rc == 2 && strstr(out, "a\\x0ab\\x1b[31m.json"), "file name escaped (%d): %s", rc, out);
+    CHECK(nl && nl[1] == 0 && !strchr(out, '\033'), "one line, no raw ESC: %s", out);
+    snprintf(cmd, sizeof cmd, "%s x.json --width \"$(head -c 100000 /dev/zero | tr '\\0' 9)\"",
+             tu_vbcl);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--width 999") && strstr(out, "...") && strlen(out) < 300,
+          "a 100,000-character value is cut (%d, %zu characters): %.300s", rc, strlen(out), out);
+    snprintf(cmd, sizeof cmd, "%s x.json \"$(printf -- '--e\\033]0;x\\007')\"", tu_vbcl);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--e\\x1b]0;x\\x07") && !strchr(out, '\033'),
+          "unknown option escaped (%d): %s", rc, out);
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0], \"z\\u001b[2J\": 2}}", NULL,
+               "camera.z\\x1b[2J");
+}
+
 void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);
+    RUN_TEST(test_cli_messages_escaped);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
 }

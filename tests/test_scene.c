@@ -156,6 +156,13 @@ static void test_scene_out_of_range(void)
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"radius\": -1}]}",
                  "objects[0].radius", "out of range");
+    /* limits read as written: integers whole, open intervals as "> 0" */
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"seed\": 3000000000}}",
+                 "render.seed: 3000000000 is out of range [0, 2147483647]", NULL);
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"radius\": -1}]}",
+                 "objects[0].radius: -1 is out of range: expected > 0", NULL);
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"level\": 40}]}",
                  "objects[0].level", "out of range");
