@@ -25,7 +25,8 @@ static const char usage_text[] =
     "       vbcl --list-devices\n"
     "\n"
     "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
-    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float).\n"
+    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float). SCENE.json may be\n"
+    "a pipe; - reads it from standard input (mesh paths then start at the current directory).\n"
     "\n"
     "options (each overrides the scene's own setting):\n"
     "  -o, --output FILE        image to write (default: image.output, else SCENE.png);\n"
@@ -249,8 +250,9 @@ static char *output_path(const Options *o, const Scene *s, int frame)
 {
     if (o->output) return frame_path(o->output, frame);
     if (s->output) return frame_path(s->output, frame);
-    const char *base = strrchr(o->scene, '/');
-    base = base ? base + 1 : o->scene;
+    const char *scene = strcmp(o->scene, "-") == 0 ? "stdin" : o->scene;
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
     size_t n = strlen(base);
     const char *dot = strrchr(base, '.');
     if (dot) n = (size_t)(dot - base);
@@ -406,11 +408,11 @@ static int apply_options(const Options *o, Scene *s)
 
 /* Renders frame `frame` of the scene (-1: a scene that is not animated) on dev and writes
  * it; t0 is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
+static int render_frame(const Options *o, const char *text, int frame, VbDevice *dev, double t0)
 {
     char err[1024] = "";
     Scene s;
-    if (scene_load_frame(o->scene, frame, &s, err, sizeof err)) {
+    if (scene_load_text(o->scene, text, frame, &s, err, sizeof err)) {
         diag_print("vbcl", "%s", err);
         return 2;
     }
@@ -425,11 +427,6 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     if (!out || (o->aa_map && !map)) {
         fprintf(stderr, "vbcl: out of memory\n");
         rc = 1;
-        goto done_scene;
-    }
-    if (image_check_path(out, err, sizeof err) || (map && image_check_path(map, err, sizeof err))) {
-        diag_print("vbcl", "%s", err);
-        rc = 2;
         goto done_scene;
     }
     rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
@@ -484,6 +481,95 @@ done_scene:
     return rc;
 }
 
+/* Checks that path can be written before any work: a format vbcl writes, in a directory
+ * that exists and is writable. Returns 0, or 2 after a message naming the path. */
+static int check_output(const char *path)
+{
+    char err[1024];
+    if (image_check_path(path, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
+        return 2;
+    }
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    if (!dir) return 2;
+    int rc = 0;
+    if (access(dir, W_OK | X_OK)) {
+        int e = errno;
+        diag_print("vbcl", "%s: cannot write there: %s%s", path, strerror(e),
+                   e == ENOENT ? " (the directory does not exist)" : "");
+        rc = 2;
+    }
+    free(dir);
+    return rc;
+}
+
+/* Every output of frames first..last (or of the still image, frame -1): the image and
+ * the --aa-map, checked before anything renders. */
+static int check_outputs(const Options *o, const Scene *s, int first, int last)
+{
+    for (int f = first; f <= last; f++) {
+        char *out = output_path(o, s, f), *map = o->aa_map ? frame_path(o->aa_map, f) : NULL;
+        int rc = (!out || (o->aa_map && !map)) ? 1 : check_output(out);
+        if (!rc && map) rc = check_output(map);
+        free(out);
+        free(map);
+        if (rc) return rc;
+        if (f < 0) break;
+    }
+    return 0;
+}
+
+/* Loads every frame to be rendered with the command line applied, so that a value out
+ * of range in frame 7 stops the run before frame 0 is written. */
+static int check_frames(const Options *o, const char *text, int first, int last)
+{
+    for (int f = first; f <= last; f++) {
+        char err[1024];
+        Scene s;
+        if (scene_load_text(o->scene, text, f, &s, err, sizeof err)) {
+            diag_print("vbcl", "%s", err);
+            return 2;
+        }
+        int rc = apply_options(o, &s);
+        scene_free(&s);
+        if (rc) return rc;
+    }
+    return 0;
+}
+
+/* The scene as written, then --frames against its frame count, every frame to render and
+ * every output path. Sets the frames to render (first = last = -1: a still image). Returns
+ * 0 or an exit status. */
+static int check_scene(const Options *o, const char *text, int *first, int *last)
+{
+    char err[1024] = "";
+    Scene s;
+    if (scene_load_text(o->scene, text, -1, &s, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
+        return 2;
+    }
+    int frames = s.frames, animated = s.animated;
+    int rc = apply_options(o, &s);
+    *first = animated ? 0 : -1;
+    *last = animated ? frames - 1 : -1;
+    if (!rc && o->frame_first >= 0) {
+        if (!animated) {
+            rc = usage_error("--frames: %s is not animated", diag_value(o->scene));
+        } else {
+            *first = o->frame_first;
+            *last = o->frame_last < 0 ? frames - 1 : o->frame_last;
+            if (*last >= frames)
+                rc = usage_error("--frames %d:%d: %s has frames 0 to %d", *first, *last,
+                                 diag_value(o->scene), frames - 1);
+        }
+    }
+    if (!rc) rc = check_outputs(o, &s, *first, *last);
+    scene_free(&s);
+    if (!rc && animated) rc = check_frames(o, text, *first, *last);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
@@ -494,41 +580,28 @@ int main(int argc, char **argv)
     if (rc >= 0) return rc;
     if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
 
-    /* the scene as written: checked before any device is opened; its frame count */
-    char err[1024] = "";
-    Scene s;
-    if (scene_load(o.scene, &s, err, sizeof err)) {
+    /* the scene, read once (it may be a pipe), checked as written and in every frame to be
+     * rendered, and every output path, before any device is opened */
+    char err[1024] = "", *text = NULL;
+    int first, last;
+    if (scene_read_text(o.scene, &text, err, sizeof err)) {
         diag_print("vbcl", "%s", err);
         return 2;
     }
-    int frames = s.frames, animated = s.animated;
-    rc = apply_options(&o, &s);
-    scene_free(&s);
-    if (rc) return rc;
-    int first = 0, last = frames - 1;
-    if (o.frame_first >= 0) {
-        if (!animated) return usage_error("--frames: %s is not animated", o.scene);
-        first = o.frame_first;
-        last = o.frame_last < 0 ? frames - 1 : o.frame_last;
-        if (last >= frames)
-            return usage_error("--frames %d:%d: %s has frames 0 to %d", first, last, o.scene,
-                               frames - 1);
-    }
+    rc = check_scene(&o, text, &first, &last);
     VbDevice dev = {0};
-    const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-    rc = clu_device_open(spec, &dev, err, sizeof err);
-    if (rc) {
-        diag_print("vbcl", "%s", err);
-        return rc;
+    int opened = 0;
+    if (!rc) {
+        const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
+        rc = clu_device_open(spec, &dev, err, sizeof err);
+        if (rc) diag_print("vbcl", "%s", err);
+        opened = !rc;
     }
-    if (!animated) {
-        rc = render_frame(&o, -1, &dev, t0);
-    } else {
-        for (int f = first; f <= last && rc == 0; f++) {
-            rc = render_frame(&o, f, &dev, t0);
-            t0 = clu_now_ms();
-        }
+    for (int f = first; !rc && f <= last; f++) {
+        rc = render_frame(&o, text, f, &dev, t0);
+        t0 = clu_now_ms();
     }
-    clu_device_close(&dev);
+    if (opened) clu_device_close(&dev);
+    free(text);
     return rc;
 }

@@ -26,10 +26,27 @@ typedef struct Ctx {
     char *err;
     size_t errlen;
     int animated; /* the document has an animation (anim_apply) */
+    int frame;    /* the frame being loaded; -1: the scene as written */
+    int ntargets; /* tracks whose target was resolved into targets[] (anim_apply) */
+    char (*targets)[PATH_MAX_LEN]; /* per track: the JSON path it sets, "objects[1].eta" */
 } Ctx;
 
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* "animation.tracks[2] at frame 5: " when a track sets path or a value inside it, else
+ * "at frame 5: ": a value that is wrong in one frame of an animation. */
+static void frame_prefix(const Ctx *c, const char *path, char *out, size_t n)
+{
+    for (int t = 0; path && t < c->ntargets; t++) {
+        size_t k = strlen(c->targets[t]);
+        if (k && strncmp(path, c->targets[t], k) == 0 && strchr(".[", path[k] ? path[k] : '.')) {
+            snprintf(out, n, "animation.tracks[%d] at frame %d: ", t, c->frame);
+            return;
+        }
+    }
+    snprintf(out, n, "at frame %d: ", c->frame);
+}
 
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
 {
@@ -38,8 +55,10 @@ static int fail(Ctx *c, const char *path, const char *fmt, ...)
     va_start(ap, fmt);
     diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    char where[PATH_MAX_LEN + 64] = "";
+    if (c->frame >= 0 && c->animated) frame_prefix(c, path, where, sizeof where);
     if (path && *path)
-        diag_format(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
+        diag_format(c->err, c->errlen, "%s: %s%s: %s", c->file, where, path, msg);
     else
         diag_format(c->err, c->errlen, "%s: %s", c->file, msg);
     return -1;
@@ -237,48 +256,65 @@ static void text_position(const char *text, const char *at, int *line, int *col)
     }
 }
 
-static int read_file(Ctx *c, const char *path, char **out)
+/* Whether path names standard input ("-" or "/dev/stdin"): read from the stream already
+ * open, with mesh paths relative to the current directory. */
+static int is_stdin(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return fail(c, NULL, "cannot open: %s", strerror(errno));
+    return strcmp(path, "-") == 0 || strcmp(path, "/dev/stdin") == 0;
+}
+
+/* Reads f whole, at most SCENE_MAX_FILE_BYTES and no NUL byte (a pipe or device may never
+ * end: /dev/zero stops at its first byte). */
+static int read_stream(Ctx *c, FILE *f, char **out)
+{
     size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap + 1);
-    if (!buf) {
-        fclose(f);
-        return fail(c, NULL, "out of memory");
-    }
+    if (!buf) return fail(c, NULL, "out of memory");
     size_t got;
     while ((got = fread(buf + len, 1, cap - len, f)) > 0) {
+        if (memchr(buf + len, 0, got)) {
+            free(buf);
+            return fail(c, NULL, "file contains a NUL byte: not a JSON text file");
+        }
         len += got;
         if (len == cap) {
-            if (cap > ((size_t)1 << 30)) {
+            if (cap >= SCENE_MAX_FILE_BYTES) {
                 free(buf);
-                fclose(f);
                 return fail(c, NULL, "file larger than 1 GiB");
             }
             char *nb = realloc(buf, cap * 2 + 1);
             if (!nb) {
                 free(buf);
-                fclose(f);
                 return fail(c, NULL, "out of memory");
             }
             buf = nb;
             cap *= 2;
         }
     }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
+    if (ferror(f)) {
         free(buf);
-        return fail(c, NULL, "read error");
+        return fail(c, NULL, "read error: %s", strerror(errno));
     }
     buf[len] = 0;
-    if (strlen(buf) != len) {
-        free(buf);
-        return fail(c, NULL, "file contains a NUL byte: not a JSON text file");
-    }
     *out = buf;
     return 0;
+}
+
+int scene_read_text(const char *path, char **text, char *err, size_t errlen)
+{
+    Ctx c = {.file = scene_display_name(path), .err = err, .errlen = errlen, .frame = -1};
+    *text = NULL;
+    if (is_stdin(path)) return read_stream(&c, stdin, text) ? 2 : 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return fail(&c, NULL, "cannot open: %s", strerror(errno)), 2;
+    int rc = read_stream(&c, f, text);
+    fclose(f);
+    return rc ? 2 : 0;
+}
+
+const char *scene_display_name(const char *path)
+{
+    return strcmp(path, "-") == 0 ? "<stdin>" : path;
 }
 
 int scene_parse_grid(const char *text, int res[3])
@@ -1178,12 +1214,19 @@ static int anim_value(Ctx *c, const cJSON *j, const char *path, AnimValue *out)
  * elements by index or by their "name". A missing last member is created (a setting left at
  * its default), and so are missing objects on the way inside an element of an array (an
  * object's transform); anything else must exist. */
-static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val)
+static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val,
+                    char *canon)
 {
     char buf[PATH_MAX_LEN];
+    canon[0] = 0;
     if (strlen(target) >= sizeof buf || !*target) {
         cJSON_Delete(val);
         return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+    }
+    if (target[0] == '.' || target[strlen(target) - 1] == '.' || strstr(target, "..")) {
+        cJSON_Delete(val);
+        return fail(c, path, "\"%s\": an empty component (expected names between the dots)",
+                    diag_value(target));
     }
     strcpy(buf, target);
     cJSON *node = root;
@@ -1217,8 +1260,12 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             }
             next = cJSON_GetArrayItem(node, index);
             in_element = 1;
+            size_t k = strlen(canon);
+            snprintf(canon + k, PATH_MAX_LEN - k, "[%d]", index);
         } else if (cJSON_IsObject(node)) {
             next = cJSON_GetObjectItemCaseSensitive(node, seg);
+            size_t k = strlen(canon);
+            snprintf(canon + k, PATH_MAX_LEN - k, "%s%s", k ? "." : "", seg);
             if (!next && node == root) {
                 cJSON_Delete(val);
                 return fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
@@ -1284,6 +1331,8 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
     const cJSON *tracks = cJSON_GetObjectItemCaseSensitive(a, "tracks");
     if (!cJSON_IsArray(tracks) || cJSON_GetArraySize(tracks) < 1)
         return fail(c, "animation.tracks", "expected an array of {\"target\", \"keys\"}");
+    c->targets = calloc((size_t)cJSON_GetArraySize(tracks), sizeof *c->targets);
+    if (!c->targets) return fail(c, NULL, "out of memory");
     for (int ti = 0; ti < cJSON_GetArraySize(tracks); ti++) {
         const cJSON *t = cJSON_GetArrayItem(tracks, ti);
         char p[PATH_MAX_LEN], q[PATH_MAX_LEN], kp[PATH_MAX_LEN];
@@ -1324,7 +1373,7 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
         }
         if (fhi < flo || frame <= flo) hi = lo, fhi = flo; /* before the first key: hold it */
         if (frame < 0) {
-            if (anim_set(c, root, target->valuestring, q, NULL)) return -1;
+            if (anim_set(c, root, target->valuestring, q, NULL, c->targets[ti])) return -1;
             continue;
         }
         double w = fhi > flo ? (frame - flo) / (fhi - flo) : 0.0;
@@ -1334,7 +1383,8 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
         for (int i = 0; i < n; i++) out[i] = lo.v[i] + w * (hi.v[i] - lo.v[i]);
         cJSON *val = lo.n ? cJSON_CreateDoubleArray(out, lo.n) : cJSON_CreateNumber(out[0]);
         if (!val) return fail(c, NULL, "out of memory");
-        if (anim_set(c, root, target->valuestring, q, val)) return -1;
+        if (anim_set(c, root, target->valuestring, q, val, c->targets[ti])) return -1;
+        c->ntargets = ti + 1;
     }
     return 0;
 }
@@ -1346,79 +1396,154 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen)
 
 int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t errlen)
 {
+    char *text = NULL;
+    memset(s, 0, sizeof *s);
+    if (scene_read_text(path, &text, err, errlen)) return 2;
+    int rc = scene_load_text(path, text, frame, s, err, errlen);
+    free(text);
+    return rc;
+}
+
+/* The error at the position `at` of text: "FILE:LINE:COL: message". */
+static int fail_at(const Ctx *c, const char *text, const char *at, const char *msg)
+{
+    int line, col;
+    text_position(text, at, &line, &col);
+    diag_format(c->err, c->errlen, "%s:%d:%d: %s", c->file, line, col, msg);
+    return -1;
+}
+
+/* A string at s (just past its opening quote) holding \u0000: cJSON would cut it there, so
+ * "fov\u0000zoom" would read as "fov". Reported as an unknown key or a bad string. */
+static int fail_nul_string(const Ctx *c, const char *text, const char *s)
+{
+    const char *e = s;
+    while (*e && *e != '"') e += (*e == '\\' && e[1]) ? 2 : 1;
+    const char *after = *e ? e + 1 : e;
+    while (*after == ' ' || *after == '\t' || *after == '\r' || *after == '\n') after++;
+    char raw[128], msg[512];
+    snprintf(raw, sizeof raw, "%.*s", (int)(e - s < 100 ? e - s : 100), s);
+    if (*after == ':')
+        snprintf(msg, sizeof msg, "unknown key \"%s\" (a key cannot hold \\u0000)",
+                 diag_value(raw));
+    else
+        snprintf(msg, sizeof msg, "JSON string \"%s\" holds \\u0000 (NUL), which is not allowed",
+                 diag_value(raw));
+    return fail_at(c, text, s - 1, msg);
+}
+
+/* What cJSON accepts but JSON does not, or reads otherwise than written: numbers with
+ * leading zeros (040) and strings holding \u0000. Checked on the raw text, with line:col. */
+static int check_raw_text(const Ctx *c, const char *text)
+{
+    char prev = ' ';
+    for (const char *p = text; *p; p++) {
+        if (*p == '"') { /* a whole string: escapes skipped, \u0000 refused */
+            const char *q = p + 1;
+            while (*q && *q != '"') {
+                if (*q == '\\' && strncmp(q + 1, "u0000", 5) == 0)
+                    return fail_nul_string(c, text, p + 1);
+                q += (*q == '\\' && q[1]) ? 2 : 1;
+            }
+            if (!*q) return 0; /* unterminated: the parser reports it */
+            p = q;
+            prev = '"';
+            continue;
+        }
+        int starts = (*p == '-' || isdigit((unsigned char)*p)) &&
+                     !(isalnum((unsigned char)prev) || prev == '.' || prev == '+' || prev == '-');
+        const char *d = *p == '-' ? p + 1 : p;
+        if (starts && d[0] == '0' && isdigit((unsigned char)d[1]))
+            return fail_at(c, text, d,
+                           "JSON syntax error: a number cannot start with 0 (write 40, not 040)");
+        prev = *p;
+    }
+    return 0;
+}
+
+/* Parses text into *root, or writes "FILE:LINE:COL: JSON syntax error ..." into err. */
+static int parse_json(const Ctx *c, const char *text, cJSON **root)
+{
+    const char *end = NULL;
+    *root = cJSON_ParseWithOpts(text, &end, 1);
+    if (*root) return 0;
+    const char *at = end ? end : cJSON_GetErrorPtr();
+    int line, col;
+    if (!at) at = text;
+    text_position(text, at, &line, &col);
+    char near[24] = "";
+    size_t k = 0;
+    for (const char *q = at; *q && *q != '\n' && k < 16; q++) near[k++] = *q;
+    near[k] = 0;
+    if (*at == 0)
+        diag_format(c->err, c->errlen, "%s:%d:%d: JSON syntax error: unexpected end of file",
+                    c->file, line, col);
+    else
+        diag_format(c->err, c->errlen, "%s:%d:%d: JSON syntax error near \"%s\"", c->file, line,
+                    col, near);
+    return -1;
+}
+
+/* Everything inside the document root, for the frame anim_apply has set. */
+static int load_document(Ctx *c, const cJSON *root, Scene *s)
+{
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (!cam) return fail(c, "camera", "missing (expected an object with eye and look_at)");
+    const cJSON *img = cJSON_GetObjectItemCaseSensitive(root, "image");
+    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (desc && !cJSON_IsString(desc))
+        return fail(c, "description", "expected a string, got %s", json_type_name(desc));
+    if (img) {
+        if (load_image(c, img, s)) return -1;
+    } else {
+        s->width = s->height = 400;
+    }
+    if (load_camera(c, cam, s) ||
+        load_render(c, cJSON_GetObjectItemCaseSensitive(root, "render"), s) ||
+        load_lights(c, cJSON_GetObjectItemCaseSensitive(root, "lights"), s) ||
+        load_materials(c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
+        load_objects(c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
+        return -1;
+    default_band_layout(cJSON_GetObjectItemCaseSensitive(root, "render"), s);
+    return 0;
+}
+
+int scene_load_text(const char *path, const char *text, int frame, Scene *s, char *err,
+                    size_t errlen)
+{
     static const char *const keys[] = {"description", "image",   "camera",    "render", "lights",
                                        "materials",   "objects", "animation", NULL};
-    Ctx c = {path, err, errlen, 0};
+    Ctx c = {.file = scene_display_name(path), .err = err, .errlen = errlen, .frame = frame};
     memset(s, 0, sizeof *s);
     mesh_init(&s->mesh);
-    char *text = NULL;
     cJSON *root = NULL;
-    if (!(s->path = dup_string(path))) goto oom;
-    if (!(s->dir = dup_string(path))) goto oom;
+    if (!(s->path = dup_string(path)) || !(s->dir = dup_string(is_stdin(path) ? "" : path)))
+        goto oom;
     char *slash = strrchr(s->dir, '/');
     if (slash)
         *(slash == s->dir ? slash + 1 : slash) = 0;
     else
         s->dir[0] = 0;
-    if (read_file(&c, path, &text)) goto fail;
-    const char *end = NULL;
-    root = cJSON_ParseWithOpts(text, &end, 1);
-    if (!root) {
-        const char *at = end ? end : cJSON_GetErrorPtr();
-        int line, col;
-        if (!at) at = text;
-        text_position(text, at, &line, &col);
-        char near[24] = "";
-        size_t k = 0;
-        for (const char *q = at; *q && *q != '\n' && k < 16; q++) near[k++] = *q;
-        near[k] = 0;
-        if (*at == 0)
-            snprintf(err, errlen, "%s:%d:%d: JSON syntax error: unexpected end of file", path, line,
-                     col);
-        else
-            snprintf(err, errlen, "%s:%d:%d: JSON syntax error near \"%s\"", path, line, col, near);
-        goto fail;
-    }
+    if (check_raw_text(&c, text) || parse_json(&c, text, &root)) goto fail;
     if (expect_object(&c, root, "") || check_keys(&c, root, "", keys) ||
         anim_apply(&c, root, frame, &s->frames))
         goto fail;
     if (frame >= s->frames) {
+        c.frame = -1;
         fail(&c, "animation.frames", "frame %d asked for, the scene has %d", frame, s->frames);
         goto fail;
     }
     s->frame = frame < 0 ? 0 : frame;
     s->animated = c.animated;
-    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
-    if (!cam) {
-        fail(&c, "camera", "missing (expected an object with eye and look_at)");
-        goto fail;
-    }
-    const cJSON *img = cJSON_GetObjectItemCaseSensitive(root, "image");
-    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
-    if (desc && !cJSON_IsString(desc)) {
-        fail(&c, "description", "expected a string, got %s", json_type_name(desc));
-        goto fail;
-    }
-    if (img) {
-        if (load_image(&c, img, s)) goto fail;
-    } else {
-        s->width = s->height = 400;
-    }
-    if (load_camera(&c, cam, s) ||
-        load_render(&c, cJSON_GetObjectItemCaseSensitive(root, "render"), s) ||
-        load_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights"), s) ||
-        load_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
-        load_objects(&c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
-        goto fail;
-    default_band_layout(cJSON_GetObjectItemCaseSensitive(root, "render"), s);
+    if (load_document(&c, root, s)) goto fail;
     cJSON_Delete(root);
-    free(text);
+    free(c.targets);
     return 0;
 oom:
-    snprintf(err, errlen, "%s: out of memory", path);
+    diag_format(err, errlen, "%s: out of memory", c.file);
 fail:
     cJSON_Delete(root);
-    free(text);
+    free(c.targets);
     scene_free(s);
     return 2;
 }

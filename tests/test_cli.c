@@ -300,6 +300,80 @@ static void test_cli_bad_input_classes(void)
           "missing scene: %s", out);
 }
 
+/* A scene read through a pipe (issue 17): a named pipe and "-" are read exactly once (a
+ * second open would wait forever); with "-" mesh paths start at the current directory. */
+static void test_cli_scene_from_pipe(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file("piped.json", GOOD_SCENE);
+    char cmd[4096], out[8192], img[512];
+    snprintf(img, sizeof img, "%s/piped.png", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             "cd %s && rm -f fifo.json && mkfifo fifo.json && (cat %s > fifo.json &) && "
+             "timeout 60 %s%s fifo.json -q -o %s",
+             tu_tmpdir(), scene, tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, img);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && file_exists(img), "a named pipe renders (%d): %s", rc, out);
+    /* "-": the mesh tri.obj is found in the current directory */
+    tu_write_file("pipe_tri.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    const char *mesh_scene = tu_write_file("pipe_mesh.json", MESH_SCENE("pipe_tri.obj"));
+    remove(img);
+    snprintf(cmd, sizeof cmd, "cd %s && timeout 60 %s%s - -q -o %s --width 8 --height 8 < %s",
+             tu_tmpdir(), tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, img, mesh_scene);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && file_exists(img), "- with a relative mesh renders (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "cat %s | timeout 60 %s /dev/stdin -q -o %s --width 8 --height 8",
+             scene, tu_vbcl, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "/dev/stdin from a pipe renders (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "printf '{\"camera\": ' | timeout 60 %s - -o %s", tu_vbcl, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "<stdin>:1:12: JSON syntax error"), "bad scene on stdin: %s", out);
+}
+
+/* Every output path is checked before any work (issue 17): a missing directory for the
+ * image, the --aa-map or a frame exits 2 naming the path as given, writing nothing. */
+static void test_cli_outputs_checked_first(void)
+{
+    const char *scene = tu_write_file("out_good.json", GOOD_SCENE);
+    char args[2048], out[8192], img[512];
+    snprintf(img, sizeof img, "%s/checked.png", tu_tmpdir());
+    remove(img);
+    snprintf(args, sizeof args, "%s -o %s --aa 0.1 --aa-map %s/nodir/map.png", scene, img,
+             tu_tmpdir());
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nodir/map.png: cannot write there") && !file_exists(img),
+          "missing --aa-map directory: nothing rendered (%d): %s", rc, out);
+    snprintf(args, sizeof args, "%s -o %s/nodir/x.png", scene, tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nodir/x.png: cannot write there") && !strstr(out, ".tmp"),
+          "missing -o directory named as given (%d): %s", rc, out);
+    expect_bad(GOOD_SCENE, "-o /proc/nodir/x.exr", "/proc/nodir/x.exr");
+}
+
+/* An animation whose frame 1 is out of range fails before frame 0 is written, naming the
+ * track and the frame (issue 17). */
+static void test_cli_animation_checked_first(void)
+{
+    const char *scene = tu_write_file(
+        "anim_bad.json",
+        "{\"image\": {\"width\": 8, \"height\": 8},"
+        " \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+        " \"materials\": {\"m\": {}}, \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}],"
+        " \"animation\": {\"frames\": 2, \"tracks\": [{\"target\": \"camera.fov\","
+        "   \"keys\": [[0, 40], [1, 400]]}]}}");
+    char args[2048], out[8192], path[512];
+    snprintf(path, sizeof path, "%s/animbad_0.png", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s/animbad_#.png", scene, tu_tmpdir());
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "animation.tracks[0] at frame 1: camera.fov: 400 is out of range"),
+          "frame 1 named (%d): %s", rc, out);
+    CHECK(!file_exists(path), "frame 0 not written");
+}
+
 /* Control characters in a file name, an argument or a key appear as \xNN, and a huge
  * value is cut: every message stays one harmless line (issue 17). */
 static void test_cli_messages_escaped(void)
@@ -330,6 +404,9 @@ void suite_cli(void)
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);
     RUN_TEST(test_cli_messages_escaped);
+    RUN_TEST(test_cli_scene_from_pipe);
+    RUN_TEST(test_cli_outputs_checked_first);
+    RUN_TEST(test_cli_animation_checked_first);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
 }

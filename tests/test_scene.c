@@ -111,6 +111,32 @@ static void test_scene_bad_syntax(void)
     expect_error("{\"camera\": {}} trailing", "scene.json:1:", "syntax");
 }
 
+/* What cJSON accepts but JSON does not, or reads otherwise than written (issue 17): a key
+ * holding \u0000 ("fov\u0000zoom" would read as "fov"), numbers with leading zeros. */
+static void test_scene_raw_json(void)
+{
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0],\n"
+                 "  \"fov\\u0000zoom\": 30}}",
+                 "scene.json:2:3: unknown key \"fov\\u0000zoom\"", NULL);
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0],\n  \"fov\": 040}}",
+                 "scene.json:2:10: JSON syntax error", "start with 0");
+    expect_error("{\"camera\": {\"eye\": [0, 0, -05], \"look_at\": [0, 0, 0]}}",
+                 "scene.json:1:28: JSON syntax error", "start with 0");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"a.obj\\u0000.ply\"}]}",
+                 "scene.json:3:", "\\u0000");
+    /* what stays valid: 0, -0.5, 1e05, 0e1, and digits inside strings */
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(MIN_SCENE_HEAD " \"render\": {\"seed\": 0, \"min_weight\": 1e-05,"
+                                      " \"ambient\": [0, 0.05, 0e1]},"
+                                      " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                      " \"name\": \"007\", \"centre\": [-0.5, 0, 1e05]}]}",
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "valid numbers load: %s", err);
+    if (rc == 0) scene_free(&s);
+}
+
 static void test_scene_unknown_keys(void)
 {
     expect_error(MIN_SCENE_HEAD " \"objects\": [], \"lihgts\": []}", "lihgts", "unknown key");
@@ -401,8 +427,14 @@ static void test_scene_animation(void)
     rc = scene_load_frame(hot, 0, &s, err, sizeof err);
     CHECK(rc == 0, "frame 0: %s", err);
     if (rc == 0) scene_free(&s);
-    CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 && strstr(err, "materials.m.k_global"),
-          "frame 3: %s", err);
+    CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 &&
+              strstr(err, "animation.tracks[0] at frame 3: materials.m.k_global: 2.5 is out of"),
+          "frame 3 names the track and the frame: %s", err);
+    /* an empty component is not skipped (issue 17) */
+    expect_error(ANIM_BAD("{\"target\": \"camera..fov\", \"keys\": [[0, 30]]}"),
+                 "animation.tracks[0].target", "empty component");
+    expect_error(ANIM_BAD("{\"target\": \"camera.fov.\", \"keys\": [[0, 30]]}"),
+                 "animation.tracks[0].target", "empty component");
 #undef ANIM_BAD
 }
 
@@ -414,6 +446,7 @@ void suite_scene(void)
     RUN_TEST(test_scene_minimal_defaults);
     RUN_TEST(test_scene_all_shapes_and_transform);
     RUN_TEST(test_scene_bad_syntax);
+    RUN_TEST(test_scene_raw_json);
     RUN_TEST(test_scene_unknown_keys);
     RUN_TEST(test_scene_wrong_types);
     RUN_TEST(test_scene_unknown_names);
