@@ -575,6 +575,27 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
     return 0;
 }
 
+/* The first wavelength where the model's index is not a finite number > 0, or 0: every
+ * nanometre of [380, 780] and every band centre of every layout renders can sample. */
+static double disp_bad_wavelength(const DispModel *d)
+{
+    for (int l = (int)DISP_LAMBDA_MIN; l <= (int)DISP_LAMBDA_MAX; l++) {
+        double n = disp_eta(d, l);
+        if (!isfinite(n) || !(n > 0)) return l;
+    }
+    DispBand bands[DISP_MAX_BANDS];
+    for (int n = 1; n <= DISP_MAX_BANDS + 1; n++) {
+        int k = n <= DISP_MAX_BANDS
+                    ? disp_layout_bands(DISP_LAYOUT_UNIFORM, n, bands)
+                    : disp_layout_bands(DISP_LAYOUT_THESIS, DISP_THESIS_BANDS, bands);
+        for (int b = 0; b < k; b++) {
+            double eta = disp_eta(d, bands[b].centre);
+            if (!isfinite(eta) || !(eta > 0)) return bands[b].centre;
+        }
+    }
+    return 0;
+}
+
 /* materials.NAME.dispersion: {"model": "thesis", "spread": Δη} (eta at 670 nm, thesis 3.5),
  * {"model": "cauchy", "abbe": V_d} (n_d = the material's eta),
  * {"model": "sellmeier", "preset": "BK7" | "F2"} or {"model": "sellmeier", "B": [3], "C": [3]},
@@ -633,6 +654,16 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
         d->band_lo = band[0];
         d->band_hi = band[1];
         d->jump = jump;
+    }
+    double bad = disp_bad_wavelength(d);
+    if (bad > 0) {
+        char v[32] = "not a number (eta squared < 0)";
+        double n = disp_eta(d, bad);
+        if (!isnan(n)) snprintf(v, sizeof v, "%g", n);
+        return fail(c, p,
+                    "eta at %g nm is %s: it must be finite and > 0 at every wavelength "
+                    "from %g to %g nm",
+                    bad, v, DISP_LAMBDA_MIN, DISP_LAMBDA_MAX);
     }
     return 0;
 }
