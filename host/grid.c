@@ -377,9 +377,8 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
         uint64_t cells = 1;
         for (int i = 0; i < 3 && cells <= GRID_MAX_CELLS; i++) cells *= (uint64_t)res[i];
         if (cells > GRID_MAX_CELLS) {
-            grid_error(err, errlen,
-                       "grid: resolution %dx%dx%d gives %.0f cells, more than the limit %u", res[0],
-                       res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
+            grid_error(err, errlen, "resolution %dx%dx%d gives %.0f cells, more than the limit %u",
+                       res[0], res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
             return -1;
         }
         for (int i = 0; i < 3; i++) g->n[i] = res[i];

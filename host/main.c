@@ -36,7 +36,8 @@ static const char usage_text[] =
     "                           default: all of them\n"
     "      --width N            image width in pixels (1..16384)\n"
     "      --height N           image height in pixels (1..16384)\n"
-    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto)\n"
+    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto; 1..1024 per axis,\n"
+    "                           at most 134217728 cells in all)\n"
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
@@ -401,7 +402,8 @@ static int apply_options(const Options *o, Scene *s)
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o->grid && scene_parse_grid(o->grid, s->grid_res))
-        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)",
+        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each, at most 2^27 = "
+                           "134217728 cells in all)",
                            diag_value(o->grid));
     return 0;
 }

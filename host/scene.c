@@ -340,6 +340,7 @@ int scene_parse_grid(const char *text, int res[3])
         v[1] = v[2] = v[0];
     else if (n != 3)
         return -1;
+    if ((uint64_t)v[0] * (uint64_t)v[1] * (uint64_t)v[2] > GRID_MAX_CELLS) return -1;
     for (int i = 0; i < 3; i++) res[i] = (int)v[i];
     return 0;
 }
@@ -464,6 +465,13 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                 s->grid_res[i] = (int)v[i];
             }
         }
+        uint64_t cells = (uint64_t)s->grid_res[0] * s->grid_res[1] * s->grid_res[2];
+        if (cells > GRID_MAX_CELLS)
+            return fail(c, "render.grid",
+                        "%dx%dx%d is %llu cells, more than the limit of %u (2^27) in all: use "
+                        "\"auto\" or fewer cells",
+                        s->grid_res[0], s->grid_res[1], s->grid_res[2], (unsigned long long)cells,
+                        GRID_MAX_CELLS);
     }
     return 0;
 }
@@ -864,6 +872,13 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
         int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
         if (n < 2 || n > 100000)
             return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
+        /* two triangles per segment per step and cap ring: refused before allocating */
+        uint64_t most = 2ull * (uint64_t)segments * (uint64_t)(n - 1 + 2);
+        if (s->mesh.ntris + most > SCENE_MAX_TRIANGLES)
+            return fail(c, p,
+                        "%d profile points x %d segments make up to %llu triangles, and the "
+                        "scene may have at most %u in all: use fewer segments or points",
+                        n, segments, (unsigned long long)most, SCENE_MAX_TRIANGLES);
         float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
         if (!prof) return fail(c, NULL, "out of memory");
         int i = 0;
@@ -913,14 +928,16 @@ static mat4 texture_mapping(const float block[6], vec3 host_lo, vec3 host_hi, co
 SceneTexgenFn scene_texgen;
 
 /* Reads the texture block a vbcl texgen file declares in its header ("# block x0 y0 z0 x1
- * y1 z1" in OBJ, "comment block ..." in PLY). Returns 1 when found and valid. */
-static int read_block_comment(const char *path, float block[6])
+ * y1 z1" in OBJ, "comment block ..." in PLY), from the file's first bytes `head`.
+ * Returns 1 when found and valid. */
+static int read_block_comment(const char *head, float block[6])
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    char line[512];
     int found = 0;
-    for (int n = 0; n < 64 && !found && fgets(line, sizeof line, f); n++) {
+    for (int n = 0; n < 64 && !found && *head; n++) {
+        char line[512];
+        size_t k = strcspn(head, "\n");
+        snprintf(line, sizeof line, "%.*s", (int)(k < sizeof line ? k : sizeof line - 1), head);
+        head += k + (head[k] == '\n');
         const char *l = line;
         if (*l == '#')
             l++;
@@ -932,10 +949,9 @@ static int read_block_comment(const char *path, float block[6])
         if (strncmp(l, "block ", 6) != 0) continue;
         found = sscanf(l + 6, "%f %f %f %f %f %f", &block[0], &block[1], &block[2], &block[3],
                        &block[4], &block[5]) == 6;
-        for (int k = 0; k < 3 && found; k++)
-            found = isfinite(block[k]) && isfinite(block[k + 3]) && block[k + 3] > block[k];
+        for (int i = 0; i < 3 && found; i++)
+            found = isfinite(block[i]) && isfinite(block[i + 3]) && block[i + 3] > block[i];
     }
-    fclose(f);
     return found;
 }
 
@@ -945,6 +961,18 @@ static int generate_texture(Ctx *c, const char *q, const char *args, char *path,
                             int *temporary)
 {
     char dir[4096], err[768];
+    size_t w0 = strspn(args, " \t\n"), w1 = strcspn(args + w0, " \t\n");
+    if ((w1 == 7 && !strncmp(args + w0, "fourier", 7)) ||
+        (w1 == 7 && !strncmp(args + w0, "project", 7)))
+        return fail(c, q,
+                    "texgen %.7s makes an image, a surface pattern, not a volume texture: give the "
+                    "material a \"pattern\" {\"type\": \"%s\"} (docs/scene-format.md)",
+                    args + w0, args[w0] == 'f' ? "fourier" : "projection");
+    if (!(w1 == 4 && !strncmp(args + w0, "bomb", 4)) &&
+        !(w1 == 6 && !strncmp(args + w0, "deform", 6)))
+        return fail(c, q,
+                    "expected \"bomb ...\" or \"deform ...\" (the texgen methods that make "
+                    "volume textures)");
     uint64_t h = cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: ");
     h = cache_hash(h, args);
     *temporary = 0;
@@ -1011,9 +1039,10 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
         join_path(full, sizeof full, s->dir, f->valuestring);
         shown = f->valuestring;
     }
-    int bad = mesh_load(full, tex, merr, sizeof merr);
+    char head[8192];
+    int bad = mesh_load_head(full, tex, head, sizeof head, merr, sizeof merr);
     float declared[6];
-    int has_declared = !bad && read_block_comment(full, declared);
+    int has_declared = !bad && read_block_comment(head, declared);
     if (temporary) remove(full);
     if (bad) return fail(c, q, "%s", merr);
     if (mesh_check_closed(tex, merr, sizeof merr))
@@ -1077,6 +1106,10 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     if (name && (!cJSON_IsString(name) || strlen(name->valuestring) >= SCENE_NAME_MAX))
         return fail(c, q, "expected a string of at most %d characters", SCENE_NAME_MAX - 1);
     snprintf(ob->name, sizeof ob->name, "%s", name ? name->valuestring : p);
+    for (int k = 0; name && k < i; k++) /* an animation track finds objects by name */
+        if (s->objects[k].named && strcmp(s->objects[k].name, ob->name) == 0)
+            return fail(c, q, "\"%s\" is already used by objects[%d]", diag_value(ob->name), k);
+    ob->named = name != NULL;
     const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
     path_key(q, p, "shape");
     if (!shape)

@@ -36,6 +36,7 @@ typedef struct SceneMaterial {
 
 typedef struct SceneObject {
     char name[SCENE_NAME_MAX]; /* the JSON path ("objects[2]") when not named */
+    int named;                 /* the scene gave "name" (unique among the objects) */
     int material;
     int is_host;      /* a closed volume tracked by the medium state (dielectric or textured) */
     int tex_slot;     /* -1: no volume texture */
@@ -128,7 +129,8 @@ void scene_free(Scene *s);
  * of a ray from p in double precision. */
 void scene_medium_at(const Scene *s, vec3 p, VbMedium *m);
 
-/* Parses a grid resolution as written on the command line: "auto", "N" or "NX,NY,NZ".
+/* Parses a grid resolution as written on the command line: "auto", "N" or "NX,NY,NZ"
+ * (1..GRID_MAX_AXIS each, at most GRID_MAX_CELLS in all).
  * Returns 0 and sets res (all 0 for auto), or -1. */
 int scene_parse_grid(const char *text, int res[3]);
 

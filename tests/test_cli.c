@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "image_io.h"
@@ -31,7 +32,7 @@ static int file_exists(const char *path)
 static int vbcl(const char *args, char *out, size_t n)
 {
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s %s", tu_vbcl, args);
+    snprintf(cmd, sizeof cmd, "timeout 300 %s %s", tu_vbcl, args); /* a hang fails (124) */
     return tu_run(cmd, out, n);
 }
 
@@ -374,6 +375,24 @@ static void test_cli_animation_checked_first(void)
     CHECK(!file_exists(path), "frame 0 not written");
 }
 
+/* A mesh must be a regular file of at most 1 GiB (issue 17): a link to /dev/zero grew
+ * memory until the machine ran out; a pipe would wait forever. */
+static void test_cli_mesh_files_capped(void)
+{
+    char path[512], cmd[1024];
+    snprintf(path, sizeof path, "%s/zero.obj", tu_tmpdir());
+    remove(path);
+    if (symlink("/dev/zero", path)) CHECK(0, "symlink %s", path);
+    snprintf(cmd, sizeof cmd,
+             "cd %s && rm -f fifo.obj && mkfifo fifo.obj && truncate -s 1100M big.obj",
+             tu_tmpdir());
+    CHECK(tu_run(cmd, NULL, 0) == 0, "mkfifo and truncate");
+    expect_bad(MESH_SCENE("zero.obj"), NULL, "zero.obj: not a regular file");
+    expect_bad(MESH_SCENE("fifo.obj"), NULL, "fifo.obj: not a regular file");
+    expect_bad(MESH_SCENE("big.obj"), NULL,
+               "big.obj: 1153433600 bytes, more than the limit of 1 GiB");
+}
+
 /* Control characters in a file name, an argument or a key appear as \xNN, and a huge
  * value is cut: every message stays one harmless line (issue 17). */
 static void test_cli_messages_escaped(void)
@@ -407,6 +426,7 @@ void suite_cli(void)
     RUN_TEST(test_cli_scene_from_pipe);
     RUN_TEST(test_cli_outputs_checked_first);
     RUN_TEST(test_cli_animation_checked_first);
+    RUN_TEST(test_cli_mesh_files_capped);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
 }

@@ -257,6 +257,13 @@ static void test_scene_parse_grid(void)
     CHECK(scene_parse_grid("0", r) == -1, "zero rejected");
     CHECK(scene_parse_grid("5000", r) == -1, "too large rejected");
     CHECK(scene_parse_grid("x", r) == -1, "text rejected");
+    /* each axis in range but 2^30 cells in all: refused when read, saying what to do */
+    CHECK(scene_parse_grid("1024", r) == -1, "1024^3 rejected");
+    CHECK(scene_parse_grid("1024,1024,128", r) == 0, "2^27 cells accepted");
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"grid\": [1024, 1024, 1024]}}",
+                 "scene.json: render.grid: 1024x1024x1024 is 1073741824 cells, more than the limit",
+                 "use \"auto\" or fewer cells");
 }
 
 /* A texture generated inline from texgen's arguments: generated once into the cache,
@@ -318,6 +325,61 @@ static void test_scene_texture_generate_inline(void)
         " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
         "   \"texture\": {\"generate\": \"bomb\", \"file\": \"a.obj\", \"material\": \"m\"}}]}",
         "objects[0].texture", "not both");
+    /* Fourier synthesis and projection make images, surface patterns (issue 17) */
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \"fourier --terms 5\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate: texgen fourier makes an image, a surface pattern",
+                 "\"pattern\" {\"type\": \"fourier\"}");
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \" project x.png\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "{\"type\": \"projection\"}");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                "   \"texture\": {\"generate\": \"bombs\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "expected \"bomb ...\" or \"deform ...\"");
+}
+
+/* A shape's triangle count is known from its parameters and refused before it is built
+ * (issue 17): 13,000 profile points x 4,096 segments once took 5 GB and 20 s. */
+static void test_scene_triangles_counted_first(void)
+{
+    size_t cap = 13000 * 24 + 1024, len = 0;
+    char *text = malloc(cap);
+    if (!text) return;
+    len += (size_t)snprintf(text, cap, "%s",
+                            MIN_SCENE_HEAD " \"objects\": [{\"shape\": "
+                                           "\"revolution\", \"material\": \"m\", "
+                                           "\"segments\": 4096, \"profile\": [");
+    for (int i = 0; i < 13000; i++)
+        len += (size_t)snprintf(text + len, cap - len, "%s[%d, %d]", i ? "," : "", 1 + i % 2, i);
+    snprintf(text + len, cap - len, "]}]}");
+    double t0 = clu_now_ms();
+    expect_error(text, "objects[0]: 13000 profile points x 4096 segments make up to", "fewer");
+    double ms = clu_now_ms() - t0;
+    CHECK(ms < 3000, "refused in %.0f ms, before tessellating", ms);
+    free(text);
+}
+
+/* Object names are unique: an animation track finds an object by its name (issue 17). */
+static void test_scene_duplicate_names(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"a\", \"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"b\", \"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"a\", \"shape\": \"box\", \"material\": \"m\"}],\n"
+                                " \"animation\": {\"frames\": 2, \"tracks\": [{\"target\":"
+                                " \"objects.a.transform.scale\", \"keys\": [[0, 1], [1, 2]]}]}}",
+                 "objects[3].name: \"a\" is already used by objects[1]", NULL);
+    /* an unnamed object is known by its path, which a name may repeat harmlessly */
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},"
+                                      " {\"name\": \"objects[0]\", \"shape\": \"box\", "
+                                      "\"material\": \"m\"}]}",
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "distinct names load: %s", err);
+    if (rc == 0) scene_free(&s);
 }
 
 /* Every example scene in the repository loads (meshes, textures and all). */
@@ -447,6 +509,8 @@ void suite_scene(void)
     RUN_TEST(test_scene_all_shapes_and_transform);
     RUN_TEST(test_scene_bad_syntax);
     RUN_TEST(test_scene_raw_json);
+    RUN_TEST(test_scene_duplicate_names);
+    RUN_TEST(test_scene_triangles_counted_first);
     RUN_TEST(test_scene_unknown_keys);
     RUN_TEST(test_scene_wrong_types);
     RUN_TEST(test_scene_unknown_names);
