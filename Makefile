@@ -148,7 +148,7 @@ oclgrind: $(BUILD)/vbcl
 FUZZ_SECONDS ?= 60
 FUZZ_CC      ?= clang
 FUZZ_TARGETS := scene mesh_obj mesh_ply
-FUZZ_SRC     := host/scene.c host/diag.c host/mesh.c host/mesh_io.c host/shapes.c host/grid.c host/cache.c \
+FUZZ_SRC     := host/scene.c host/diag.c host/mesh.c host/mesh_meet.c host/mesh_io.c host/shapes.c host/grid.c host/cache.c \
                 host/dispersion.c
 build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk
 	@mkdir -p $(dir $@)

@@ -53,6 +53,20 @@ int mesh_load_head(const char *path, Mesh *out, char *head, size_t headlen, char
  * Returns 0, or -1 with a message naming one offending edge (its two vertex positions). */
 int mesh_check_closed(const Mesh *m, char *err, size_t errlen);
 
+/* Triangles [first, first + ntris) of mesh: one object, or one element of a texture. */
+typedef struct MeshPart {
+    const Mesh *mesh;
+    uint32_t first, ntris;
+} MeshPart;
+
+/* Whether the surfaces of two different parts meet, touching included (exact orientation
+ * tests in double precision, coplanar triangles included; triangle bounding boxes swept
+ * along z first). Returns 1 and the parts *pa < *pb with one triangle of each (*ta of
+ * part *pa, *tb of *pb, counted within the part), 0 when they are disjoint, -1 when out
+ * of memory. */
+int mesh_parts_meet(const MeshPart *parts, int nparts, int *pa, int *pb, uint32_t *ta,
+                    uint32_t *tb);
+
 /* Tessellated primitives, centred at the origin, outward-oriented, appended to m.
  * Each returns 0, or -1 when out of memory. */
 /* Unit-radius sphere: an icosahedron subdivided `level` times (0..7), smooth normals. */

@@ -1169,6 +1169,8 @@ done:
     return rc;
 }
 
+static int check_hosts_disjoint(Ctx *c, const Scene *s);
+
 static int load_objects(Ctx *c, const cJSON *j, Scene *s)
 {
     if (!j) return fail(c, "objects", "missing (expected an array of objects)");
@@ -1187,7 +1189,7 @@ static int load_objects(Ctx *c, const cJSON *j, Scene *s)
         s->nobjects = i + 1;
     }
     if (s->mesh.ntris == 0) return fail(c, "objects", "no triangles to render");
-    return 0;
+    return check_hosts_disjoint(c, s);
 }
 
 /* Signed crossings of the ray p + t*d (t > 0) with triangles [first, first+n) of the
@@ -1223,6 +1225,82 @@ static int signed_crossings(const Scene *s, uint32_t first, uint32_t n, const do
         count += det < 0.0 ? 1 : -1;
     }
     return count;
+}
+
+/* Whether object a has a vertex inside object b (both closed): a host nested in another. */
+static int vertex_inside(const Scene *s, const SceneObject *a, const SceneObject *b)
+{
+    static const double d[3] = {0.5773502691896258 + 0.0131, 0.5773502691896258 - 0.0217,
+                                0.5773502691896258 + 0.0071};
+    vec3 v = s->mesh.verts[s->mesh.tris[3 * a->first_tri]];
+    const double p[3] = {v.x, v.y, v.z};
+    return signed_crossings(s, b->first_tri, b->ntris, p, d) > 0;
+}
+
+static void object_bounds(const Scene *s, const SceneObject *o, vec3 *lo, vec3 *hi)
+{
+    *lo = v3(FLT_MAX, FLT_MAX, FLT_MAX);
+    *hi = v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+    for (uint32_t t = o->first_tri; t < o->first_tri + o->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            vec3 p = s->mesh.verts[s->mesh.tris[3 * t + k]];
+            *lo = v3_min(*lo, p);
+            *hi = v3_max(*hi, p);
+        }
+}
+
+/* Hosts (dielectric or textured objects) must not overlap: the medium the kernels track is
+ * one host at a time. Refused: surfaces that meet or touch (mesh_parts_meet, the exact test
+ * texgen uses for its elements) and one host inside another. Only hosts whose bounding box
+ * overlaps another host's are tested. */
+static int check_hosts_disjoint(Ctx *c, const Scene *s)
+{
+    int nh = 0, np = 0, *idx = malloc(sizeof(int) * 2 * (size_t)s->nobjects);
+    MeshPart *parts = malloc(sizeof *parts * (size_t)s->nobjects);
+    vec3 *box = malloc(sizeof *box * 2 * (size_t)s->nobjects);
+    int rc = (!idx || !parts || !box) ? fail(c, NULL, "out of memory") : 0;
+    int *pobj = idx ? idx + s->nobjects : NULL; /* per part: its object */
+    for (int i = 0; !rc && i < s->nobjects; i++)
+        if (s->objects[i].is_host) {
+            object_bounds(s, &s->objects[i], &box[2 * nh], &box[2 * nh + 1]);
+            idx[nh++] = i;
+        }
+    for (int i = 0; !rc && i < nh; i++) {
+        int near = 0;
+        for (int j = 0; !rc && j < nh; j++) {
+            vec3 l0 = box[2 * i], h0 = box[2 * i + 1], l1 = box[2 * j], h1 = box[2 * j + 1];
+            if (j == i || l0.x > h1.x || l1.x > h0.x || l0.y > h1.y || l1.y > h0.y || l0.z > h1.z ||
+                l1.z > h0.z)
+                continue;
+            near = 1;
+            const SceneObject *oi = &s->objects[idx[i]], *oj = &s->objects[idx[j]];
+            if (vertex_inside(s, oi, oj))
+                rc = fail(c, "objects",
+                          "%s is inside %s: dielectric and textured objects must not overlap "
+                          "(docs/scene-format.md)",
+                          diag_value(oi->name), diag_value(oj->name));
+        }
+        if (near) {
+            const SceneObject *o = &s->objects[idx[i]];
+            pobj[np] = idx[i];
+            parts[np++] = (MeshPart){&s->mesh, o->first_tri, o->ntris};
+        }
+    }
+    int pa, pb;
+    uint32_t ta, tb;
+    int meet = rc || np < 2 ? 0 : mesh_parts_meet(parts, np, &pa, &pb, &ta, &tb);
+    if (meet < 0) rc = fail(c, NULL, "out of memory");
+    if (meet > 0)
+        rc = fail(c, "objects",
+                  "%s and %s overlap (triangle %u of one meets triangle %u of the other): "
+                  "dielectric and textured objects must not overlap or touch "
+                  "(docs/scene-format.md)",
+                  diag_value(s->objects[pobj[pa]].name), diag_value(s->objects[pobj[pb]].name), ta,
+                  tb);
+    free(idx);
+    free(parts);
+    free(box);
+    return rc;
 }
 
 void scene_medium_at(const Scene *s, vec3 p, VbMedium *m)

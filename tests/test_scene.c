@@ -361,6 +361,39 @@ static void test_scene_triangles_counted_first(void)
     free(text);
 }
 
+/* Dielectric and textured objects must not overlap (issue 17): surfaces that meet or touch,
+ * or one inside the other, name both objects; apart, or overlapping an opaque object, load. */
+static void test_scene_hosts_disjoint(void)
+{
+#define GLASS_SCENE(objs)                                                                          \
+    "{\"camera\": {\"eye\": [0, 0, 9], \"look_at\": [0, 0, 0]},"                                   \
+    " \"materials\": {\"m\": {}, \"g\": {\"k_global\": 1, \"eta\": 1.5}}, \"objects\": [" objs     \
+    "]}"
+    expect_error(
+        GLASS_SCENE("{\"shape\": \"box\", \"material\": \"m\"},"
+                    " {\"name\": \"left\", \"shape\": \"sphere\", \"material\": \"g\"},"
+                    " {\"shape\": \"sphere\", \"material\": \"g\", \"centre\": [1.5, 0, 0]}"),
+        "objects: left and objects[2] overlap", "must not overlap");
+    expect_error(GLASS_SCENE("{\"name\": \"outer\", \"shape\": \"sphere\", \"material\": \"g\","
+                             "  \"radius\": 2},"
+                             " {\"name\": \"inner\", \"shape\": \"box\", \"material\": \"g\"}"),
+                 "objects: inner is inside outer", NULL);
+    expect_error(GLASS_SCENE("{\"name\": \"a\", \"shape\": \"box\", \"material\": \"g\"},"
+                             " {\"name\": \"b\", \"shape\": \"box\", \"material\": \"g\","
+                             "  \"transform\": {\"translate\": [1, 0, 0]}}"),
+                 "objects: a and b overlap", "or touch");
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(GLASS_SCENE("{\"shape\": \"box\", \"material\": \"m\", \"size\": [3, 3, 3]},"
+                                   " {\"shape\": \"sphere\", \"material\": \"g\"},"
+                                   " {\"shape\": \"sphere\", \"material\": \"g\","
+                                   "  \"centre\": [2.01, 0, 0]}"),
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "apart, and inside an opaque box: loads: %s", err);
+    if (rc == 0) scene_free(&s);
+#undef GLASS_SCENE
+}
+
 /* Object names are unique: an animation track finds an object by its name (issue 17). */
 static void test_scene_duplicate_names(void)
 {
@@ -510,6 +543,7 @@ void suite_scene(void)
     RUN_TEST(test_scene_bad_syntax);
     RUN_TEST(test_scene_raw_json);
     RUN_TEST(test_scene_duplicate_names);
+    RUN_TEST(test_scene_hosts_disjoint);
     RUN_TEST(test_scene_triangles_counted_first);
     RUN_TEST(test_scene_unknown_keys);
     RUN_TEST(test_scene_wrong_types);
