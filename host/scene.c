@@ -779,6 +779,58 @@ static int load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     return 0;
 }
 
+/* objects[i] with "shape": "revolution": a profile swept about the y axis, its triangle
+ * count checked before it is built. */
+static int load_revolution(Ctx *c, const cJSON *o, const char *p, const Scene *s, Mesh *m)
+{
+    char q[PATH_MAX_LEN];
+    static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
+                                       "profile", "segments", "caps", NULL};
+    int segments;
+    if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
+        return -1;
+    const cJSON *caps = cJSON_GetObjectItemCaseSensitive(o, "caps");
+    path_key(q, p, "caps");
+    if (caps && !cJSON_IsBool(caps))
+        return fail(c, q, "expected true or false, got %s", json_type_name(caps));
+    path_key(q, p, "profile");
+    const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "profile");
+    if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
+    int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
+    if (n < 2 || n > 100000) return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
+    /* two triangles per segment per step and cap ring: refused before allocating */
+    uint64_t most = 2ull * (uint64_t)segments * (uint64_t)(n - 1 + 2);
+    if (s->mesh.ntris + most > SCENE_MAX_TRIANGLES)
+        return fail(c, p,
+                    "%d profile points x %d segments make up to %llu triangles, and the "
+                    "scene may have at most %u in all: use fewer segments or points",
+                    n, segments, (unsigned long long)most, SCENE_MAX_TRIANGLES);
+    float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
+    if (!prof) return fail(c, NULL, "out of memory");
+    int i = 0;
+    for (const cJSON *e = pj->child; e; e = e->next, i++) {
+        char qi[PATH_MAX_LEN];
+        path_index(qi, q, i);
+        if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, prof[i])) {
+            free(prof);
+            return -1;
+        }
+        if (prof[i][0] < 0) {
+            free(prof);
+            return fail(c, qi, "the radius r must be >= 0");
+        }
+        if (i > 0 && prof[i][0] == prof[i - 1][0] && prof[i][1] == prof[i - 1][1]) {
+            free(prof);
+            return fail(c, qi, "repeats the previous point");
+        }
+    }
+    int rc =
+        shape_revolution(m, (const float(*)[2])prof, n, segments, caps ? cJSON_IsTrue(caps) : 1);
+    free(prof);
+    if (rc) return fail(c, p, "could not tessellate the shape (out of memory)");
+    return 0;
+}
+
 /* Tessellates one object's shape into m (object space). */
 static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, const Scene *s,
                       Mesh *m)
@@ -857,50 +909,7 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
             return -1;
         rc = shape_quad(m, size[0], size[1]);
     } else if (strcmp(shape, "revolution") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
-                                           "profile", "segments", "caps", NULL};
-        int segments;
-        if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
-            return -1;
-        const cJSON *caps = cJSON_GetObjectItemCaseSensitive(o, "caps");
-        path_key(q, p, "caps");
-        if (caps && !cJSON_IsBool(caps))
-            return fail(c, q, "expected true or false, got %s", json_type_name(caps));
-        path_key(q, p, "profile");
-        const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "profile");
-        if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
-        int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
-        if (n < 2 || n > 100000)
-            return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
-        /* two triangles per segment per step and cap ring: refused before allocating */
-        uint64_t most = 2ull * (uint64_t)segments * (uint64_t)(n - 1 + 2);
-        if (s->mesh.ntris + most > SCENE_MAX_TRIANGLES)
-            return fail(c, p,
-                        "%d profile points x %d segments make up to %llu triangles, and the "
-                        "scene may have at most %u in all: use fewer segments or points",
-                        n, segments, (unsigned long long)most, SCENE_MAX_TRIANGLES);
-        float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
-        if (!prof) return fail(c, NULL, "out of memory");
-        int i = 0;
-        for (const cJSON *e = pj->child; e; e = e->next, i++) {
-            char qi[PATH_MAX_LEN];
-            path_index(qi, q, i);
-            if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, prof[i])) {
-                free(prof);
-                return -1;
-            }
-            if (prof[i][0] < 0) {
-                free(prof);
-                return fail(c, qi, "the radius r must be >= 0");
-            }
-            if (i > 0 && prof[i][0] == prof[i - 1][0] && prof[i][1] == prof[i - 1][1]) {
-                free(prof);
-                return fail(c, qi, "repeats the previous point");
-            }
-        }
-        rc = shape_revolution(m, (const float(*)[2])prof, n, segments,
-                              caps ? cJSON_IsTrue(caps) : 1);
-        free(prof);
+        return load_revolution(c, o, p, s, m);
     } else {
         path_key(q, p, "shape");
         return fail(c, q,
@@ -1351,6 +1360,18 @@ static int anim_value(Ctx *c, const cJSON *j, const char *path, AnimValue *out)
     return 0;
 }
 
+/* A track's target path: 1 to PATH_MAX_LEN - 1 characters, no empty component
+ * ("camera..fov" is not "camera.fov"). */
+static int check_target(Ctx *c, const char *target, const char *path)
+{
+    if (strlen(target) >= PATH_MAX_LEN || !*target)
+        return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+    if (target[0] == '.' || target[strlen(target) - 1] == '.' || strstr(target, ".."))
+        return fail(c, path, "\"%s\": an empty component (expected names between the dots)",
+                    diag_value(target));
+    return 0;
+}
+
 /* Sets the member a track's target names, "materials.glass.eta" or "objects.ball.transform.
  * rotate", to val (taken over; NULL only checks the path): object members by key, array
  * elements by index or by their "name". A missing last member is created (a setting left at
@@ -1361,14 +1382,9 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
 {
     char buf[PATH_MAX_LEN];
     canon[0] = 0;
-    if (strlen(target) >= sizeof buf || !*target) {
+    if (check_target(c, target, path)) {
         cJSON_Delete(val);
-        return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
-    }
-    if (target[0] == '.' || target[strlen(target) - 1] == '.' || strstr(target, "..")) {
-        cJSON_Delete(val);
-        return fail(c, path, "\"%s\": an empty component (expected names between the dots)",
-                    diag_value(target));
+        return -1;
     }
     strcpy(buf, target);
     cJSON *node = root;
