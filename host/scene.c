@@ -779,9 +779,9 @@ static int load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     return 0;
 }
 
-/* objects[i] with "shape": "revolution": a profile swept about the y axis, its triangle
- * count checked before it is built. */
-static int load_revolution(Ctx *c, const cJSON *o, const char *p, const Scene *s, Mesh *m)
+/* objects[i] with "shape": "revolution": a profile swept about the y axis (its triangle
+ * count was checked before any shape was built: count_triangles_first). */
+static int load_revolution(Ctx *c, const cJSON *o, const char *p, Mesh *m)
 {
     char q[PATH_MAX_LEN];
     static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
@@ -798,13 +798,6 @@ static int load_revolution(Ctx *c, const cJSON *o, const char *p, const Scene *s
     if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
     int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
     if (n < 2 || n > 100000) return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
-    /* two triangles per segment per step and cap ring: refused before allocating */
-    uint64_t most = 2ull * (uint64_t)segments * (uint64_t)(n - 1 + 2);
-    if (s->mesh.ntris + most > SCENE_MAX_TRIANGLES)
-        return fail(c, p,
-                    "%d profile points x %d segments make up to %llu triangles, and the "
-                    "scene may have at most %u in all: use fewer segments or points",
-                    n, segments, (unsigned long long)most, SCENE_MAX_TRIANGLES);
     float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
     if (!prof) return fail(c, NULL, "out of memory");
     int i = 0;
@@ -909,7 +902,7 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
             return -1;
         rc = shape_quad(m, size[0], size[1]);
     } else if (strcmp(shape, "revolution") == 0) {
-        return load_revolution(c, o, p, s, m);
+        return load_revolution(c, o, p, m);
     } else {
         path_key(q, p, "shape");
         return fail(c, q,
@@ -1178,6 +1171,56 @@ done:
     return rc;
 }
 
+/* The triangles objects[i] will have, from its parameters alone (a mesh file's are known
+ * only when read: 0 here), described in what; parameters that are wrong count 0 (the
+ * object's own checks report them). */
+static uint64_t shape_triangles(const cJSON *o, char *what, size_t n)
+{
+    const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
+    const char *sh = cJSON_IsString(shape) ? shape->valuestring : "";
+    const cJSON *lv = cJSON_GetObjectItemCaseSensitive(o, "level");
+    const cJSON *sg = cJSON_GetObjectItemCaseSensitive(o, "segments");
+    const cJSON *pr = cJSON_GetObjectItemCaseSensitive(o, "profile");
+    if (strcmp(sh, "sphere") == 0) {
+        double level = lv ? (cJSON_IsNumber(lv) ? lv->valuedouble : -1) : 3;
+        if (!(level >= 0 && level <= 7 && level == floor(level))) return 0;
+        snprintf(what, n, "a sphere of level %d has", (int)level);
+        return 20ull << (2 * (int)level);
+    }
+    if (strcmp(sh, "revolution") == 0) {
+        double seg = sg ? (cJSON_IsNumber(sg) ? sg->valuedouble : -1) : 32;
+        int points = cJSON_IsArray(pr) ? cJSON_GetArraySize(pr) : 0;
+        if (!(seg >= 3 && seg <= 4096) || points < 2 || points > 100000) return 0;
+        snprintf(what, n, "%d profile points x %d segments make up to", points, (int)seg);
+        /* two triangles per segment per step and per cap ring */
+        return 2ull * (uint64_t)seg * (uint64_t)(points + 1);
+    }
+    snprintf(what, n, "the shape has");
+    return strcmp(sh, "box") == 0     ? 12
+           : strcmp(sh, "prism") == 0 ? 8
+           : strcmp(sh, "quad") == 0  ? 2
+                                      : 0;
+}
+
+/* Refuses a scene whose shapes make more than SCENE_MAX_TRIANGLES before any is built. */
+static int count_triangles_first(Ctx *c, const cJSON *j)
+{
+    uint64_t total = 0;
+    int i = 0;
+    for (const cJSON *o = j->child; o; o = o->next, i++) {
+        char what[128], p[PATH_MAX_LEN];
+        uint64_t n = shape_triangles(o, what, sizeof what);
+        total += n;
+        if (total <= SCENE_MAX_TRIANGLES) continue;
+        path_index(p, "objects", i);
+        return fail(c, p,
+                    "%s %llu triangles, %llu with the objects before it, and a scene may have at "
+                    "most %u: use fewer segments, profile points or a lower level",
+                    what, (unsigned long long)n, (unsigned long long)total, SCENE_MAX_TRIANGLES);
+    }
+    return 0;
+}
+
 static int check_hosts_disjoint(Ctx *c, const Scene *s);
 
 static int load_objects(Ctx *c, const cJSON *j, Scene *s)
@@ -1188,6 +1231,7 @@ static int load_objects(Ctx *c, const cJSON *j, Scene *s)
     int n = cJSON_GetArraySize(j);
     if (n == 0) return fail(c, "objects", "the scene is empty: expected at least one object");
     if (n > 0x7fffffff / 2) return fail(c, "objects", "too many objects");
+    if (count_triangles_first(c, j)) return -1;
     s->objects = calloc((size_t)n, sizeof *s->objects);
     if (!s->objects) return fail(c, NULL, "out of memory");
     int i = 0;

@@ -347,8 +347,9 @@ static void test_scene_texture_generate_inline(void)
                  "objects[0].texture.generate", "expected \"bomb ...\" or \"deform ...\"");
 }
 
-/* A shape's triangle count is known from its parameters and refused before it is built
- * (issue 17): 13,000 profile points x 4,096 segments once took 5 GB and 20 s. */
+/* Every shape's triangle count is known from its parameters, and the scene is refused
+ * before any is built (issue 17): 13,000 profile points x 4,096 segments once took 5 GB
+ * and 20 s, 200 spheres of level 7 took 27 s and 1.5 GB. */
 static void test_scene_triangles_counted_first(void)
 {
     size_t cap = 13000 * 24 + 1024, len = 0;
@@ -364,6 +365,18 @@ static void test_scene_triangles_counted_first(void)
     double t0 = clu_now_ms();
     expect_error(text, "objects[0]: 13000 profile points x 4096 segments make up to", "fewer");
     double ms = clu_now_ms() - t0;
+    CHECK(ms < 3000, "refused in %.0f ms, before tessellating", ms);
+    /* 200 spheres of level 7: the 153rd passes the limit, found before the first is built */
+    len = (size_t)snprintf(text, cap, "%s", MIN_SCENE_HEAD " \"objects\": [");
+    for (int i = 0; i < 200; i++)
+        len += (size_t)snprintf(text + len, cap - len,
+                                "%s{\"shape\": \"sphere\", \"level\": 7, \"material\": \"m\"}",
+                                i ? "," : "");
+    snprintf(text + len, cap - len, "]}");
+    t0 = clu_now_ms();
+    expect_error(text, "objects[152]: a sphere of level 7 has 327680 triangles, 50135040 with",
+                 NULL);
+    ms = clu_now_ms() - t0;
     CHECK(ms < 3000, "refused in %.0f ms, before tessellating", ms);
     free(text);
 }
