@@ -2,6 +2,8 @@
  * (separating axes in double), and the compact layout in two passes (count, then fill). */
 #include "grid.h"
 
+#include "diag.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -40,7 +42,7 @@ static void grid_error(char *err, size_t errlen, const char *fmt, ...)
     if (!err || errlen == 0) return;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
+    diag_vformat(err, errlen, fmt, ap);
     va_end(ap);
 }
 
