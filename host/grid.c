@@ -2,8 +2,6 @@
  * (separating axes in double), and the compact layout in two passes (count, then fill). */
 #include "grid.h"
 
-#include "diag.h"
-
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -11,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include "diag.h"
 
 /* An axis thinner than this fraction of the largest extent is flat: `auto` gives it one cell,
  * as cube-ish cells could not split it without the other axes exceeding GRID_MAX_AXIS.

@@ -1,8 +1,6 @@
 /* mesh_io.c — loads triangle meshes from Wavefront OBJ and PLY (ASCII and binary) files. */
 #include "mesh.h"
 
-#include "diag.h"
-
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -10,6 +8,8 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+
+#include "diag.h"
 
 /* ---- shared helpers ---- */
 
