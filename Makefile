@@ -144,12 +144,15 @@ oclgrind: $(BUILD)/vbcl
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_dispersion.json "$(OCLGRIND_FLAGS)" 1e-3
 
 # libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
-# run for FUZZ_SECONDS each from the seed corpus in tests/fuzz/corpus/ (docs/testing.md).
+# run from the seed corpus in tests/fuzz/corpus/ (docs/testing.md): FUZZ_RUNS executions
+# per parser when given (failing if FUZZ_SECONDS runs out first), else FUZZ_SECONDS each.
+# Prints each parser's executions, time and rate. CI: FUZZ_RUNS=1000000 FUZZ_SECONDS=900.
 FUZZ_SECONDS ?= 60
+FUZZ_RUNS    ?=
 FUZZ_CC      ?= clang
 FUZZ_TARGETS := scene mesh_obj mesh_ply
-FUZZ_SRC     := host/scene.c host/mesh.c host/mesh_io.c host/shapes.c host/grid.c host/cache.c \
-                host/dispersion.c
+FUZZ_SRC     := host/scene.c host/diag.c host/mesh.c host/mesh_meet.c host/mesh_io.c host/shapes.c \
+                host/grid.c host/cache.c host/dispersion.c
 build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk
 	@mkdir -p $(dir $@)
 	@echo "  FUZZ    $@"
@@ -160,13 +163,20 @@ build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build
 fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
 	$(Q)for t in $(FUZZ_TARGETS); do \
 	    corpus=$$(echo $$t | sed 's/^mesh_//'); mkdir -p build/fuzz/work-$$t; \
-	    echo "fuzz: $$t for $(FUZZ_SECONDS) s (seeds: tests/fuzz/corpus/$$corpus)"; \
+	    echo "fuzz: $$t: $(if $(FUZZ_RUNS),$(FUZZ_RUNS) executions (at most $(FUZZ_SECONDS) s),$(FUZZ_SECONDS) s) (seeds: tests/fuzz/corpus/$$corpus)"; \
+	    t0=$$(date +%s); \
 	    build/fuzz/fuzz_$$t build/fuzz/work-$$t tests/fuzz/corpus/$$corpus \
-	        -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
+	        -max_total_time=$(FUZZ_SECONDS) $(if $(FUZZ_RUNS),-runs=$(FUZZ_RUNS)) -timeout=10 \
+	        -rss_limit_mb=2048 -max_len=16384 \
 	        -print_final_stats=1 -artifact_prefix=build/fuzz/crash-$$t- \
 	        > build/fuzz/$$t.log 2>&1 || { tail -40 build/fuzz/$$t.log; \
 	        echo "fuzz: $$t FAILED: the input is in build/fuzz/crash-$$t-*"; exit 1; }; \
-	    grep -E '^stat::(number_of_executed_units|new_units_added)' build/fuzz/$$t.log; \
+	    secs=$$(( $$(date +%s) - t0 )); \
+	    execs=$$(sed -n 's/^stat::number_of_executed_units: *//p' build/fuzz/$$t.log); \
+	    new=$$(sed -n 's/^stat::new_units_added: *//p' build/fuzz/$$t.log); \
+	    echo "fuzz: $$t: $$execs executions in $$secs s ($$(( execs / (secs > 0 ? secs : 1) ))/s), $$new new inputs"; \
+	    if [ -n "$(FUZZ_RUNS)" ] && [ "$$execs" -lt "$(FUZZ_RUNS)" ]; then \
+	        echo "fuzz: $$t reached only $$execs of $(FUZZ_RUNS) executions in $(FUZZ_SECONDS) s"; exit 1; fi; \
 	done
 
 FORMAT_FILES := $(wildcard host/*.c host/*.h host/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \

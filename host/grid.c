@@ -10,6 +10,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "diag.h"
+
 /* An axis thinner than this fraction of the largest extent is flat: `auto` gives it one cell,
  * as cube-ish cells could not split it without the other axes exceeding GRID_MAX_AXIS.
  * grid_build widens a flat axis to 3e-4 of the largest extent, padding included. */
@@ -40,7 +42,7 @@ static void grid_error(char *err, size_t errlen, const char *fmt, ...)
     if (!err || errlen == 0) return;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
+    diag_vformat(err, errlen, fmt, ap);
     va_end(ap);
 }
 
@@ -377,9 +379,8 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
         uint64_t cells = 1;
         for (int i = 0; i < 3 && cells <= GRID_MAX_CELLS; i++) cells *= (uint64_t)res[i];
         if (cells > GRID_MAX_CELLS) {
-            grid_error(err, errlen,
-                       "grid: resolution %dx%dx%d gives %.0f cells, more than the limit %u", res[0],
-                       res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
+            grid_error(err, errlen, "resolution %dx%dx%d gives %.0f cells, more than the limit %u",
+                       res[0], res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
             return -1;
         }
         for (int i = 0; i < 3; i++) g->n[i] = res[i];

@@ -94,6 +94,8 @@ extern "C" int image_write(const char *path, int width, int height, const float 
     if (ok) ok = out->close();
     if (!ok) {
         std::string msg = out->geterror();
+        for (size_t at; (at = msg.find(tmp)) != std::string::npos;) // the name the user gave
+            msg.replace(at, tmp.size(), path);
         out.reset();
         std::remove(tmp.c_str());
         std::snprintf(err, errlen, "%s: cannot write: %s", path, msg.c_str());

@@ -12,6 +12,7 @@
 #include "aa.h"
 #include "frame.h"
 #include "clu.h"
+#include "diag.h"
 #include "kernel_features.h"
 #include "image_io.h"
 #include "render.h"
@@ -25,7 +26,8 @@ static const char usage_text[] =
     "       vbcl --list-devices\n"
     "\n"
     "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
-    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float).\n"
+    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float). SCENE.json may be\n"
+    "a pipe; - reads it from standard input (mesh paths then start at the current directory).\n"
     "\n"
     "options (each overrides the scene's own setting):\n"
     "  -o, --output FILE        image to write (default: image.output, else SCENE.png);\n"
@@ -35,7 +37,8 @@ static const char usage_text[] =
     "                           default: all of them\n"
     "      --width N            image width in pixels (1..16384)\n"
     "      --height N           image height in pixels (1..16384)\n"
-    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto)\n"
+    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto; 1..1024 per axis,\n"
+    "                           at most 134217728 cells in all)\n"
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
@@ -76,12 +79,12 @@ static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)
 
 static int usage_error(const char *fmt, ...)
 {
+    char msg[2048];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "vbcl: ");
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, " (see vbcl --help)\n");
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    diag_print("vbcl", "%s (see vbcl --help)", msg);
     return 2;
 }
 
@@ -91,7 +94,8 @@ static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
     errno = 0;
     long v = strtol(s, &end, 10);
     if (end == s || *end || errno || v < lo || v > hi) {
-        fprintf(stderr, "vbcl: %s %s: expected a whole number from %d to %d\n", opt, s, lo, hi);
+        diag_print("vbcl", "%s %s: expected a whole number from %d to %d", opt, diag_value(s), lo,
+                   hi);
         return -1;
     }
     *out = (int)v;
@@ -104,7 +108,8 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
     errno = 0;
     double v = strtod(s, &end);
     if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "vbcl: %s %s: expected a number from %g to %g\n", opt, s, lo, hi);
+        diag_print("vbcl", "%s %s: expected a number from %s to %s", opt, diag_value(s),
+                   diag_num(lo), diag_num(hi));
         return -1;
     }
     *out = v;
@@ -124,7 +129,7 @@ static int parse_args(int argc, char **argv, Options *o)
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
 #define NEEDS_VALUE                                                                                \
     do {                                                                                           \
-        if (!val) return usage_error("%s needs a value", a);                                       \
+        if (!val) return usage_error("%s needs a value", diag_value(a));                           \
         i++;                                                                                       \
     } while (0)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -147,7 +152,7 @@ static int parse_args(int argc, char **argv, Options *o)
                 if (end == b) f1 = -1;
             }
             if (end == val || *end || errno || f0 < 0 || f1 < f0 || f1 > 100000)
-                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", val);
+                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", diag_value(val));
             o->frame_first = (int)f0;
             o->frame_last = (int)f1;
         } else if (!strcmp(a, "--width")) {
@@ -174,7 +179,7 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "--fresnel")) {
             NEEDS_VALUE;
             if (strcmp(val, "exact") && strcmp(val, "thesis"))
-                return usage_error("--fresnel %s: expected exact or thesis", val);
+                return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
             o->fresnel = val;
         } else if (!strcmp(a, "--exposure")) {
             NEEDS_VALUE;
@@ -208,9 +213,9 @@ static int parse_args(int argc, char **argv, Options *o)
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
         } else if (a[0] == '-' && a[1]) {
-            return usage_error("unknown option %s", a);
+            return usage_error("unknown option %s", diag_value(a));
         } else if (o->scene) {
-            return usage_error("one scene at a time (also got %s)", a);
+            return usage_error("one scene at a time (also got %s)", diag_value(a));
         } else {
             o->scene = a;
         }
@@ -247,8 +252,9 @@ static char *output_path(const Options *o, const Scene *s, int frame)
 {
     if (o->output) return frame_path(o->output, frame);
     if (s->output) return frame_path(s->output, frame);
-    const char *base = strrchr(o->scene, '/');
-    base = base ? base + 1 : o->scene;
+    const char *scene = strcmp(o->scene, "-") == 0 ? "stdin" : o->scene;
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
     size_t n = strlen(base);
     const char *dot = strrchr(base, '.');
     if (dot) n = (size_t)(dot - base);
@@ -397,18 +403,20 @@ static int apply_options(const Options *o, Scene *s)
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o->grid && scene_parse_grid(o->grid, s->grid_res))
-        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each)", o->grid);
+        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each, at most 2^27 = "
+                           "134217728 cells in all)",
+                           diag_value(o->grid));
     return 0;
 }
 
 /* Renders frame `frame` of the scene (-1: a scene that is not animated) on dev and writes
  * it; t0 is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
+static int render_frame(const Options *o, const char *text, int frame, VbDevice *dev, double t0)
 {
     char err[1024] = "";
     Scene s;
-    if (scene_load_frame(o->scene, frame, &s, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+    if (scene_load_text(o->scene, text, frame, &s, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
         return 2;
     }
     int rc = apply_options(o, &s);
@@ -425,11 +433,6 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
         rc = 1;
         goto done_scene;
     }
-    if (image_check_path(out, err, sizeof err) || (map && image_check_path(map, err, sizeof err))) {
-        fprintf(stderr, "vbcl: %s\n", err);
-        rc = 2;
-        goto done_scene;
-    }
     rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
     if (!rgba) {
         fprintf(stderr, "vbcl: cannot allocate a %dx%d image\n", s.width, s.height);
@@ -438,23 +441,23 @@ static int render_frame(const Options *o, int frame, VbDevice *dev, double t0)
     }
     rc = frame_init(&fr, dev, &s, &st, err, sizeof err);
     if (rc) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         goto done_renderer;
     }
     int progress = !o->quiet && isatty(STDERR_FILENO);
     if (frame_render(&fr, &s, rgba, &st, progress, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
     double tw = clu_now_ms();
     if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
     if (map && frame_levels(&fr) && write_aa_map(map, &s, frame_levels(&fr), err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+        diag_print("vbcl", "%s", err);
         rc = 1;
         goto done_renderer;
     }
@@ -482,6 +485,95 @@ done_scene:
     return rc;
 }
 
+/* Checks that path can be written before any work: a format vbcl writes, in a directory
+ * that exists and is writable. Returns 0, or 2 after a message naming the path. */
+static int check_output(const char *path)
+{
+    char err[1024];
+    if (image_check_path(path, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
+        return 2;
+    }
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    if (!dir) return 2;
+    int rc = 0;
+    if (access(dir, W_OK | X_OK)) {
+        int e = errno;
+        diag_print("vbcl", "%s: cannot write there: %s%s", path, strerror(e),
+                   e == ENOENT ? " (the directory does not exist)" : "");
+        rc = 2;
+    }
+    free(dir);
+    return rc;
+}
+
+/* Every output of frames first..last (or of the still image, frame -1): the image and
+ * the --aa-map, checked before anything renders. */
+static int check_outputs(const Options *o, const Scene *s, int first, int last)
+{
+    for (int f = first; f <= last; f++) {
+        char *out = output_path(o, s, f), *map = o->aa_map ? frame_path(o->aa_map, f) : NULL;
+        int rc = (!out || (o->aa_map && !map)) ? 1 : check_output(out);
+        if (!rc && map) rc = check_output(map);
+        free(out);
+        free(map);
+        if (rc) return rc;
+        if (f < 0) break;
+    }
+    return 0;
+}
+
+/* Loads every frame to be rendered with the command line applied, so that a value out
+ * of range in frame 7 stops the run before frame 0 is written. */
+static int check_frames(const Options *o, const char *text, int first, int last)
+{
+    for (int f = first; f <= last; f++) {
+        char err[1024];
+        Scene s;
+        if (scene_load_text(o->scene, text, f, &s, err, sizeof err)) {
+            diag_print("vbcl", "%s", err);
+            return 2;
+        }
+        int rc = apply_options(o, &s);
+        scene_free(&s);
+        if (rc) return rc;
+    }
+    return 0;
+}
+
+/* The scene as written, then --frames against its frame count, every frame to render and
+ * every output path. Sets the frames to render (first = last = -1: a still image). Returns
+ * 0 or an exit status. */
+static int check_scene(const Options *o, const char *text, int *first, int *last)
+{
+    char err[1024] = "";
+    Scene s;
+    if (scene_load_text(o->scene, text, -1, &s, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
+        return 2;
+    }
+    int frames = s.frames, animated = s.animated;
+    int rc = apply_options(o, &s);
+    *first = animated ? 0 : -1;
+    *last = animated ? frames - 1 : -1;
+    if (!rc && o->frame_first >= 0) {
+        if (!animated) {
+            rc = usage_error("--frames: %s is not animated", diag_value(o->scene));
+        } else {
+            *first = o->frame_first;
+            *last = o->frame_last < 0 ? frames - 1 : o->frame_last;
+            if (*last >= frames)
+                rc = usage_error("--frames %d:%d: %s has frames 0 to %d", *first, *last,
+                                 diag_value(o->scene), frames - 1);
+        }
+    }
+    if (!rc) rc = check_outputs(o, &s, *first, *last);
+    scene_free(&s);
+    if (!rc && animated) rc = check_frames(o, text, *first, *last);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
@@ -492,41 +584,28 @@ int main(int argc, char **argv)
     if (rc >= 0) return rc;
     if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
 
-    /* the scene as written: checked before any device is opened; its frame count */
-    char err[1024] = "";
-    Scene s;
-    if (scene_load(o.scene, &s, err, sizeof err)) {
-        fprintf(stderr, "vbcl: %s\n", err);
+    /* the scene, read once (it may be a pipe), checked as written and in every frame to be
+     * rendered, and every output path, before any device is opened */
+    char err[1024] = "", *text = NULL;
+    int first, last;
+    if (scene_read_text(o.scene, &text, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
         return 2;
     }
-    int frames = s.frames, animated = s.animated;
-    rc = apply_options(&o, &s);
-    scene_free(&s);
-    if (rc) return rc;
-    int first = 0, last = frames - 1;
-    if (o.frame_first >= 0) {
-        if (!animated) return usage_error("--frames: %s is not animated", o.scene);
-        first = o.frame_first;
-        last = o.frame_last < 0 ? frames - 1 : o.frame_last;
-        if (last >= frames)
-            return usage_error("--frames %d:%d: %s has frames 0 to %d", first, last, o.scene,
-                               frames - 1);
-    }
+    rc = check_scene(&o, text, &first, &last);
     VbDevice dev = {0};
-    const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-    rc = clu_device_open(spec, &dev, err, sizeof err);
-    if (rc) {
-        fprintf(stderr, "vbcl: %s\n", err);
-        return rc;
+    int opened = 0;
+    if (!rc) {
+        const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
+        rc = clu_device_open(spec, &dev, err, sizeof err);
+        if (rc) diag_print("vbcl", "%s", err);
+        opened = !rc;
     }
-    if (!animated) {
-        rc = render_frame(&o, -1, &dev, t0);
-    } else {
-        for (int f = first; f <= last && rc == 0; f++) {
-            rc = render_frame(&o, f, &dev, t0);
-            t0 = clu_now_ms();
-        }
+    for (int f = first; !rc && f <= last; f++) {
+        rc = render_frame(&o, text, f, &dev, t0);
+        t0 = clu_now_ms();
     }
-    clu_device_close(&dev);
+    if (opened) clu_device_close(&dev);
+    free(text);
     return rc;
 }

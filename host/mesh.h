@@ -35,15 +35,37 @@ void mesh_transform(Mesh *m, const mat4 *xf);
 /* Axis-aligned bounds of the vertices; an empty mesh gives lo > hi. */
 void mesh_bounds(const Mesh *m, vec3 *lo, vec3 *hi);
 
+#define MESH_MAX_FILE_BYTES ((uint64_t)1 << 30) /* as scene files: at most 1 GiB */
+
 /* Loads a Wavefront OBJ or PLY (ASCII, binary little or big endian) file, chosen by
- * extension; polygons are fan-triangulated. Returns 0, or -1 with a one-line message in
+ * extension; polygons are fan-triangulated. The file must be a regular file (not a pipe
+ * or device) of at most MESH_MAX_FILE_BYTES. Returns 0, or -1 with a one-line message in
  * err naming the file, the line (OBJ, ASCII PLY) or element, and what was expected. */
 int mesh_load(const char *path, Mesh *out, char *err, size_t errlen);
+
+/* mesh_load that also copies the file's first headlen - 1 bytes (its header, for the
+ * comments texgen writes) into head, NUL-terminated: the file is read once. */
+int mesh_load_head(const char *path, Mesh *out, char *head, size_t headlen, char *err,
+                   size_t errlen);
 
 /* Checks that the mesh bounds a volume: every edge is shared by exactly two triangles
  * that use it in opposite directions, and no triangle is degenerate in its indices.
  * Returns 0, or -1 with a message naming one offending edge (its two vertex positions). */
 int mesh_check_closed(const Mesh *m, char *err, size_t errlen);
+
+/* Triangles [first, first + ntris) of mesh: one object, or one element of a texture. */
+typedef struct MeshPart {
+    const Mesh *mesh;
+    uint32_t first, ntris;
+} MeshPart;
+
+/* Whether the surfaces of two different parts meet, touching included (exact orientation
+ * tests in double precision, coplanar triangles included; triangle bounding boxes swept
+ * along z first). Returns 1 and the parts *pa < *pb with one triangle of each (*ta of
+ * part *pa, *tb of *pb, counted within the part), 0 when they are disjoint, -1 when out
+ * of memory. */
+int mesh_parts_meet(const MeshPart *parts, int nparts, int *pa, int *pb, uint32_t *ta,
+                    uint32_t *tb);
 
 /* Tessellated primitives, centred at the origin, outward-oriented, appended to m.
  * Each returns 0, or -1 when out of memory. */

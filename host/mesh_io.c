@@ -7,6 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+
+#include "diag.h"
 
 /* ---- shared helpers ---- */
 
@@ -20,44 +23,48 @@ typedef struct Ctx {
 static int fail(const Ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int fail(const Ctx *c, const char *fmt, ...)
 {
-    char msg[256];
+    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    snprintf(c->err, c->errlen, "%s%s", c->path, msg);
+    diag_format(c->err, c->errlen, "%s%s", c->path, msg);
     return -1;
 }
 
-/* Reads the whole file into a NUL-terminated buffer. */
+/* Reads the whole file into a NUL-terminated buffer, once: a regular file of at most
+ * MESH_MAX_FILE_BYTES (a link to /dev/zero or a pipe would never end). */
 static int read_file(const Ctx *c, char **data, size_t *len)
 {
+    struct stat st; /* before opening: opening a pipe waits for a writer */
+    if (stat(c->path, &st)) return fail(c, ": cannot open: %s", strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return fail(c, ": not a regular file (a mesh must be a file, not a %s)",
+                    S_ISDIR(st.st_mode) ? "directory" : "device, pipe or socket");
     FILE *f = fopen(c->path, "rb");
     if (!f) return fail(c, ": cannot open: %s", strerror(errno));
-    size_t cap = 1 << 16, n = 0;
+    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        return fail(c, ": not a regular file");
+    }
+    if ((uint64_t)st.st_size > MESH_MAX_FILE_BYTES) {
+        fclose(f);
+        return fail(c, ": %llu bytes, more than the limit of 1 GiB",
+                    (unsigned long long)st.st_size);
+    }
+    size_t cap = (size_t)st.st_size + 2, n = 0; /* one more byte shows a file still growing */
     char *buf = malloc(cap);
     if (!buf) {
         fclose(f);
         return fail(c, ": out of memory");
     }
-    for (;;) {
-        if (n + 1 >= cap) {
-            if (cap > SIZE_MAX / 2) break;
-            char *b = realloc(buf, cap * 2);
-            if (!b) break;
-            buf = b;
-            cap *= 2;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0) break;
-    }
-    int bad = ferror(f), eof = feof(f), read_errno = errno;
+    n = fread(buf, 1, cap - 1, f);
+    int bad = ferror(f), read_errno = errno;
     fclose(f);
-    if (bad || !eof) {
+    if (bad || n > (size_t)st.st_size) {
         free(buf);
         if (bad) return fail(c, ": cannot read: %s", strerror(read_errno));
-        return fail(c, ": out of memory reading the file");
+        return fail(c, ": the file grew while it was read");
     }
     buf[n] = '\0';
     *data = buf;
@@ -855,6 +862,12 @@ done:
 
 int mesh_load(const char *path, Mesh *out, char *err, size_t errlen)
 {
+    return mesh_load_head(path, out, NULL, 0, err, errlen);
+}
+
+int mesh_load_head(const char *path, Mesh *out, char *head, size_t headlen, char *err,
+                   size_t errlen)
+{
     Ctx c = {path, err, errlen};
     const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
     if (!dot || (slash && dot < slash)) return fail(&c, ": no file extension (.obj or .ply)");
@@ -864,6 +877,8 @@ int mesh_load(const char *path, Mesh *out, char *err, size_t errlen)
     char *data = NULL;
     size_t len = 0;
     if (read_file(&c, &data, &len) < 0) return -1;
+    if (head && headlen)
+        snprintf(head, headlen, "%.*s", (int)(len < headlen ? len : headlen - 1), data);
     int rc = is_obj ? load_obj(&c, data, len, out) : load_ply(&c, data, len, out);
     free(data);
     return rc;

@@ -15,6 +15,7 @@
 #include <cJSON.h>
 
 #include "cache.h"
+#include "diag.h"
 #include "grid.h"
 
 #define PATH_MAX_LEN 256
@@ -25,24 +26,41 @@ typedef struct Ctx {
     char *err;
     size_t errlen;
     int animated; /* the document has an animation (anim_apply) */
+    int frame;    /* the frame being loaded; -1: the scene as written */
+    int ntargets; /* tracks whose target was resolved into targets[] (anim_apply) */
+    char (*targets)[PATH_MAX_LEN]; /* per track: the JSON path it sets, "objects[1].eta" */
 } Ctx;
 
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* "animation.tracks[2] at frame 5: " when a track sets path or a value inside it, else
+ * "at frame 5: ": a value that is wrong in one frame of an animation. */
+static void frame_prefix(const Ctx *c, const char *path, char *out, size_t n)
+{
+    for (int t = 0; path && t < c->ntargets; t++) {
+        size_t k = strlen(c->targets[t]);
+        if (k && strncmp(path, c->targets[t], k) == 0 && strchr(".[", path[k] ? path[k] : '.')) {
+            snprintf(out, n, "animation.tracks[%d] at frame %d: ", t, c->frame);
+            return;
+        }
+    }
+    snprintf(out, n, "at frame %d: ", c->frame);
+}
+
 static int fail(Ctx *c, const char *path, const char *fmt, ...)
 {
-    char msg[512];
+    char msg[1024];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    char where[PATH_MAX_LEN + 64] = "";
+    if (c->frame >= 0 && c->animated) frame_prefix(c, path, where, sizeof where);
     if (path && *path)
-        snprintf(c->err, c->errlen, "%s: %s: %s", c->file, path, msg);
+        diag_format(c->err, c->errlen, "%s: %s%s: %s", c->file, where, path, msg);
     else
-        snprintf(c->err, c->errlen, "%s: %s", c->file, msg);
-    for (char *ch = c->err; *ch; ch++) /* keys and names may hold control characters */
-        if ((unsigned char)*ch < 0x20) *ch = '?';
+        diag_format(c->err, c->errlen, "%s: %s", c->file, msg);
     return -1;
 }
 
@@ -93,6 +111,30 @@ static int check_keys(Ctx *c, const cJSON *obj, const char *path, const char *co
     return 0;
 }
 
+/* The range [lo, hi] as a message shows it: "[1, 16384]", "> 0", ">= 0"; FLT_MIN or
+ * DBL_MIN as lo means an open interval at 0, FLT_MAX or DBL_MAX as hi no upper limit. */
+static const char *range_text(double lo, double hi, char *buf, size_t n)
+{
+    int open = lo == FLT_MIN || lo == DBL_MIN, unbounded = hi == FLT_MAX || hi == DBL_MAX;
+    if (open && unbounded)
+        snprintf(buf, n, "> 0");
+    else if (open)
+        snprintf(buf, n, "> 0 and <= %s", diag_num(hi));
+    else if (unbounded)
+        snprintf(buf, n, ">= %s", diag_num(lo));
+    else
+        snprintf(buf, n, "[%s, %s]", diag_num(lo), diag_num(hi));
+    return buf;
+}
+
+/* The error for a number v outside [lo, hi] at path p. */
+static int fail_range(Ctx *c, const char *p, double v, double lo, double hi)
+{
+    char r[96];
+    range_text(lo, hi, r, sizeof r);
+    return fail(c, p, "%s is out of range%s%s", diag_num(v), r[0] == '[' ? " " : ": expected ", r);
+}
+
 static int expect_object(Ctx *c, const cJSON *j, const char *path)
 {
     if (!cJSON_IsObject(j)) return fail(c, path, "expected an object, got %s", json_type_name(j));
@@ -114,7 +156,7 @@ static int get_num(Ctx *c, const cJSON *obj, const char *path, const char *key, 
     if (!cJSON_IsNumber(j)) return fail(c, p, "expected a number, got %s", json_type_name(j));
     double v = j->valuedouble;
     if (!isfinite(v)) return fail(c, p, "expected a finite number");
-    if (v < lo || v > hi) return fail(c, p, "%g is out of range [%g, %g]", v, lo, hi);
+    if (v < lo || v > hi) return fail_range(c, p, v, lo, hi);
     *out = v;
     return 0;
 }
@@ -155,7 +197,7 @@ static int read_vec(Ctx *c, const cJSON *j, const char *p, int n, double lo, dou
         if (!cJSON_IsNumber(e)) return fail(c, pi, "expected a number, got %s", json_type_name(e));
         if (!isfinite(e->valuedouble)) return fail(c, pi, "expected a finite number");
         if (e->valuedouble < lo || e->valuedouble > hi)
-            return fail(c, pi, "%g is out of range [%g, %g]", e->valuedouble, lo, hi);
+            return fail_range(c, pi, e->valuedouble, lo, hi);
         out[i] = (float)e->valuedouble;
     }
     return 0;
@@ -214,48 +256,65 @@ static void text_position(const char *text, const char *at, int *line, int *col)
     }
 }
 
-static int read_file(Ctx *c, const char *path, char **out)
+/* Whether path names standard input ("-" or "/dev/stdin"): read from the stream already
+ * open, with mesh paths relative to the current directory. */
+static int is_stdin(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return fail(c, NULL, "cannot open: %s", strerror(errno));
+    return strcmp(path, "-") == 0 || strcmp(path, "/dev/stdin") == 0;
+}
+
+/* Reads f whole, at most SCENE_MAX_FILE_BYTES and no NUL byte (a pipe or device may never
+ * end: /dev/zero stops at its first byte). */
+static int read_stream(Ctx *c, FILE *f, char **out)
+{
     size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap + 1);
-    if (!buf) {
-        fclose(f);
-        return fail(c, NULL, "out of memory");
-    }
+    if (!buf) return fail(c, NULL, "out of memory");
     size_t got;
     while ((got = fread(buf + len, 1, cap - len, f)) > 0) {
+        if (memchr(buf + len, 0, got)) {
+            free(buf);
+            return fail(c, NULL, "file contains a NUL byte: not a JSON text file");
+        }
         len += got;
         if (len == cap) {
-            if (cap > ((size_t)1 << 30)) {
+            if (cap >= SCENE_MAX_FILE_BYTES) {
                 free(buf);
-                fclose(f);
                 return fail(c, NULL, "file larger than 1 GiB");
             }
             char *nb = realloc(buf, cap * 2 + 1);
             if (!nb) {
                 free(buf);
-                fclose(f);
                 return fail(c, NULL, "out of memory");
             }
             buf = nb;
             cap *= 2;
         }
     }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
+    if (ferror(f)) {
         free(buf);
-        return fail(c, NULL, "read error");
+        return fail(c, NULL, "read error: %s", strerror(errno));
     }
     buf[len] = 0;
-    if (strlen(buf) != len) {
-        free(buf);
-        return fail(c, NULL, "file contains a NUL byte: not a JSON text file");
-    }
     *out = buf;
     return 0;
+}
+
+int scene_read_text(const char *path, char **text, char *err, size_t errlen)
+{
+    Ctx c = {.file = scene_display_name(path), .err = err, .errlen = errlen, .frame = -1};
+    *text = NULL;
+    if (is_stdin(path)) return read_stream(&c, stdin, text) ? 2 : 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return fail(&c, NULL, "cannot open: %s", strerror(errno)), 2;
+    int rc = read_stream(&c, f, text);
+    fclose(f);
+    return rc ? 2 : 0;
+}
+
+const char *scene_display_name(const char *path)
+{
+    return strcmp(path, "-") == 0 ? "<stdin>" : path;
 }
 
 int scene_parse_grid(const char *text, int res[3])
@@ -281,6 +340,7 @@ int scene_parse_grid(const char *text, int res[3])
         v[1] = v[2] = v[0];
     else if (n != 3)
         return -1;
+    if ((uint64_t)v[0] * (uint64_t)v[1] * (uint64_t)v[2] > GRID_MAX_CELLS) return -1;
     for (int i = 0; i < 3; i++) res[i] = (int)v[i];
     return 0;
 }
@@ -328,7 +388,7 @@ static int get_bands(Ctx *c, const cJSON *j, Scene *s)
     if (cJSON_IsString(b)) {
         if (strcmp(b->valuestring, "thesis") != 0)
             return fail(c, "render.bands", "expected an integer 1..%d or \"thesis\", got \"%s\"",
-                        DISP_MAX_BANDS, b->valuestring);
+                        DISP_MAX_BANDS, diag_value(b->valuestring));
         s->bands = DISP_THESIS_BANDS;
         s->band_layout = DISP_LAYOUT_THESIS;
         return 0;
@@ -405,6 +465,13 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                 s->grid_res[i] = (int)v[i];
             }
         }
+        uint64_t cells = (uint64_t)s->grid_res[0] * s->grid_res[1] * s->grid_res[2];
+        if (cells > GRID_MAX_CELLS)
+            return fail(c, "render.grid",
+                        "%dx%dx%d is %llu cells, more than the limit of %u (2^27) in all: use "
+                        "\"auto\" or fewer cells",
+                        s->grid_res[0], s->grid_res[1], s->grid_res[2], (unsigned long long)cells,
+                        GRID_MAX_CELLS);
     }
     return 0;
 }
@@ -516,6 +583,27 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
     return 0;
 }
 
+/* The first wavelength where the model's index is not a finite number > 0, or 0: every
+ * nanometre of [380, 780] and every band centre of every layout renders can sample. */
+static double disp_bad_wavelength(const DispModel *d)
+{
+    for (int l = (int)DISP_LAMBDA_MIN; l <= (int)DISP_LAMBDA_MAX; l++) {
+        double n = disp_eta(d, l);
+        if (!isfinite(n) || !(n > 0)) return l;
+    }
+    DispBand bands[DISP_MAX_BANDS];
+    for (int n = 1; n <= DISP_MAX_BANDS + 1; n++) {
+        int k = n <= DISP_MAX_BANDS
+                    ? disp_layout_bands(DISP_LAYOUT_UNIFORM, n, bands)
+                    : disp_layout_bands(DISP_LAYOUT_THESIS, DISP_THESIS_BANDS, bands);
+        for (int b = 0; b < k; b++) {
+            double eta = disp_eta(d, bands[b].centre);
+            if (!isfinite(eta) || !(eta > 0)) return bands[b].centre;
+        }
+    }
+    return 0;
+}
+
 /* materials.NAME.dispersion: {"model": "thesis", "spread": Δη} (eta at 670 nm, thesis 3.5),
  * {"model": "cauchy", "abbe": V_d} (n_d = the material's eta),
  * {"model": "sellmeier", "preset": "BK7" | "F2"} or {"model": "sellmeier", "B": [3], "C": [3]},
@@ -561,7 +649,7 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
         }
     } else {
         return fail(c, q, "expected \"thesis\", \"cauchy\" or \"sellmeier\", got \"%s\"",
-                    model->valuestring);
+                    diag_value(model->valuestring));
     }
     if (cJSON_GetObjectItemCaseSensitive(j, "band")) {
         float band[2], jump;
@@ -574,6 +662,16 @@ static int load_dispersion(Ctx *c, const cJSON *mat, const char *path, float eta
         d->band_lo = band[0];
         d->band_hi = band[1];
         d->jump = jump;
+    }
+    double bad = disp_bad_wavelength(d);
+    if (bad > 0) {
+        char v[32] = "not a number (eta squared < 0)";
+        double n = disp_eta(d, bad);
+        if (!isnan(n)) snprintf(v, sizeof v, "%g", n);
+        return fail(c, p,
+                    "eta at %g nm is %s: it must be finite and > 0 at every wavelength "
+                    "from %g to %g nm",
+                    bad, v, DISP_LAMBDA_MIN, DISP_LAMBDA_MAX);
     }
     return 0;
 }
@@ -681,6 +779,51 @@ static int load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     return 0;
 }
 
+/* objects[i] with "shape": "revolution": a profile swept about the y axis (its triangle
+ * count was checked before any shape was built: count_triangles_first). */
+static int load_revolution(Ctx *c, const cJSON *o, const char *p, Mesh *m)
+{
+    char q[PATH_MAX_LEN];
+    static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
+                                       "profile", "segments", "caps", NULL};
+    int segments;
+    if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
+        return -1;
+    const cJSON *caps = cJSON_GetObjectItemCaseSensitive(o, "caps");
+    path_key(q, p, "caps");
+    if (caps && !cJSON_IsBool(caps))
+        return fail(c, q, "expected true or false, got %s", json_type_name(caps));
+    path_key(q, p, "profile");
+    const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "profile");
+    if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
+    int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
+    if (n < 2 || n > 100000) return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
+    float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
+    if (!prof) return fail(c, NULL, "out of memory");
+    int i = 0;
+    for (const cJSON *e = pj->child; e; e = e->next, i++) {
+        char qi[PATH_MAX_LEN];
+        path_index(qi, q, i);
+        if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, prof[i])) {
+            free(prof);
+            return -1;
+        }
+        if (prof[i][0] < 0) {
+            free(prof);
+            return fail(c, qi, "the radius r must be >= 0");
+        }
+        if (i > 0 && prof[i][0] == prof[i - 1][0] && prof[i][1] == prof[i - 1][1]) {
+            free(prof);
+            return fail(c, qi, "repeats the previous point");
+        }
+    }
+    int rc =
+        shape_revolution(m, (const float(*)[2])prof, n, segments, caps ? cJSON_IsTrue(caps) : 1);
+    free(prof);
+    if (rc) return fail(c, p, "could not tessellate the shape (out of memory)");
+    return 0;
+}
+
 /* Tessellates one object's shape into m (object space). */
 static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, const Scene *s,
                       Mesh *m)
@@ -759,48 +902,12 @@ static int load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, 
             return -1;
         rc = shape_quad(m, size[0], size[1]);
     } else if (strcmp(shape, "revolution") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform", "texture",
-                                           "profile", "segments", "caps", NULL};
-        int segments;
-        if (check_keys(c, o, p, keys) || get_int(c, o, p, "segments", 3, 4096, 32, 0, &segments))
-            return -1;
-        const cJSON *caps = cJSON_GetObjectItemCaseSensitive(o, "caps");
-        path_key(q, p, "caps");
-        if (caps && !cJSON_IsBool(caps))
-            return fail(c, q, "expected true or false, got %s", json_type_name(caps));
-        path_key(q, p, "profile");
-        const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "profile");
-        if (!pj) return fail(c, q, "missing (expected an array of [r, y] points)");
-        int n = cJSON_IsArray(pj) ? cJSON_GetArraySize(pj) : 0;
-        if (n < 2 || n > 100000)
-            return fail(c, q, "expected an array of 2 to 100000 [r, y] points");
-        float(*prof)[2] = malloc(sizeof(float[2]) * (size_t)n);
-        if (!prof) return fail(c, NULL, "out of memory");
-        int i = 0;
-        for (const cJSON *e = pj->child; e; e = e->next, i++) {
-            char qi[PATH_MAX_LEN];
-            path_index(qi, q, i);
-            if (read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, prof[i])) {
-                free(prof);
-                return -1;
-            }
-            if (prof[i][0] < 0) {
-                free(prof);
-                return fail(c, qi, "the radius r must be >= 0");
-            }
-            if (i > 0 && prof[i][0] == prof[i - 1][0] && prof[i][1] == prof[i - 1][1]) {
-                free(prof);
-                return fail(c, qi, "repeats the previous point");
-            }
-        }
-        rc = shape_revolution(m, (const float(*)[2])prof, n, segments,
-                              caps ? cJSON_IsTrue(caps) : 1);
-        free(prof);
+        return load_revolution(c, o, p, m);
     } else {
         path_key(q, p, "shape");
         return fail(c, q,
                     "unknown shape \"%s\" (expected mesh, sphere, box, prism, quad or revolution)",
-                    shape);
+                    diag_value(shape));
     }
     if (rc) return fail(c, p, "could not tessellate the shape (out of memory)");
     return 0;
@@ -823,14 +930,16 @@ static mat4 texture_mapping(const float block[6], vec3 host_lo, vec3 host_hi, co
 SceneTexgenFn scene_texgen;
 
 /* Reads the texture block a vbcl texgen file declares in its header ("# block x0 y0 z0 x1
- * y1 z1" in OBJ, "comment block ..." in PLY). Returns 1 when found and valid. */
-static int read_block_comment(const char *path, float block[6])
+ * y1 z1" in OBJ, "comment block ..." in PLY), from the file's first bytes `head`.
+ * Returns 1 when found and valid. */
+static int read_block_comment(const char *head, float block[6])
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    char line[512];
     int found = 0;
-    for (int n = 0; n < 64 && !found && fgets(line, sizeof line, f); n++) {
+    for (int n = 0; n < 64 && !found && *head; n++) {
+        char line[512];
+        size_t k = strcspn(head, "\n");
+        snprintf(line, sizeof line, "%.*s", (int)(k < sizeof line ? k : sizeof line - 1), head);
+        head += k + (head[k] == '\n');
         const char *l = line;
         if (*l == '#')
             l++;
@@ -842,10 +951,9 @@ static int read_block_comment(const char *path, float block[6])
         if (strncmp(l, "block ", 6) != 0) continue;
         found = sscanf(l + 6, "%f %f %f %f %f %f", &block[0], &block[1], &block[2], &block[3],
                        &block[4], &block[5]) == 6;
-        for (int k = 0; k < 3 && found; k++)
-            found = isfinite(block[k]) && isfinite(block[k + 3]) && block[k + 3] > block[k];
+        for (int i = 0; i < 3 && found; i++)
+            found = isfinite(block[i]) && isfinite(block[i + 3]) && block[i + 3] > block[i];
     }
-    fclose(f);
     return found;
 }
 
@@ -855,6 +963,18 @@ static int generate_texture(Ctx *c, const char *q, const char *args, char *path,
                             int *temporary)
 {
     char dir[4096], err[768];
+    size_t w0 = strspn(args, " \t\n"), w1 = strcspn(args + w0, " \t\n");
+    if ((w1 == 7 && !strncmp(args + w0, "fourier", 7)) ||
+        (w1 == 7 && !strncmp(args + w0, "project", 7)))
+        return fail(c, q,
+                    "texgen %.7s makes an image, a surface pattern, not a volume texture: give the "
+                    "material a \"pattern\" {\"type\": \"%s\"} (docs/scene-format.md)",
+                    args + w0, args[w0] == 'f' ? "fourier" : "projection");
+    if (!(w1 == 4 && !strncmp(args + w0, "bomb", 4)) &&
+        !(w1 == 6 && !strncmp(args + w0, "deform", 6)))
+        return fail(c, q,
+                    "expected \"bomb ...\" or \"deform ...\" (the texgen methods that make "
+                    "volume textures)");
     uint64_t h = cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: ");
     h = cache_hash(h, args);
     *temporary = 0;
@@ -898,7 +1018,7 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
     if (!mat) return fail(c, q, "missing (expected the name of the texture's material)");
     if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
     *material = find_material(s, mat->valuestring);
-    if (*material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+    if (*material < 0) return fail(c, q, "unknown material \"%s\"", diag_value(mat->valuestring));
     const cJSON *f = cJSON_GetObjectItemCaseSensitive(t, "file");
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(t, "generate");
     char full[4096], merr[512];
@@ -921,9 +1041,10 @@ static int load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, v
         join_path(full, sizeof full, s->dir, f->valuestring);
         shown = f->valuestring;
     }
-    int bad = mesh_load(full, tex, merr, sizeof merr);
+    char head[8192];
+    int bad = mesh_load_head(full, tex, head, sizeof head, merr, sizeof merr);
     float declared[6];
-    int has_declared = !bad && read_block_comment(full, declared);
+    int has_declared = !bad && read_block_comment(head, declared);
     if (temporary) remove(full);
     if (bad) return fail(c, q, "%s", merr);
     if (mesh_check_closed(tex, merr, sizeof merr))
@@ -987,6 +1108,10 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     if (name && (!cJSON_IsString(name) || strlen(name->valuestring) >= SCENE_NAME_MAX))
         return fail(c, q, "expected a string of at most %d characters", SCENE_NAME_MAX - 1);
     snprintf(ob->name, sizeof ob->name, "%s", name ? name->valuestring : p);
+    for (int k = 0; name && k < i; k++) /* an animation track finds objects by name */
+        if (s->objects[k].named && strcmp(s->objects[k].name, ob->name) == 0)
+            return fail(c, q, "\"%s\" is already used by objects[%d]", diag_value(ob->name), k);
+    ob->named = name != NULL;
     const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
     path_key(q, p, "shape");
     if (!shape)
@@ -998,7 +1123,8 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     if (!mat) return fail(c, q, "missing (expected the name of a material)");
     if (!cJSON_IsString(mat)) return fail(c, q, "expected a string, got %s", json_type_name(mat));
     ob->material = find_material(s, mat->valuestring);
-    if (ob->material < 0) return fail(c, q, "unknown material \"%s\"", mat->valuestring);
+    if (ob->material < 0)
+        return fail(c, q, "unknown material \"%s\"", diag_value(mat->valuestring));
 
     Mesh m, tex;
     mesh_init(&m);
@@ -1045,6 +1171,58 @@ done:
     return rc;
 }
 
+/* The triangles objects[i] will have, from its parameters alone (a mesh file's are known
+ * only when read: 0 here), described in what; parameters that are wrong count 0 (the
+ * object's own checks report them). */
+static uint64_t shape_triangles(const cJSON *o, char *what, size_t n)
+{
+    const cJSON *shape = cJSON_GetObjectItemCaseSensitive(o, "shape");
+    const char *sh = cJSON_IsString(shape) ? shape->valuestring : "";
+    const cJSON *lv = cJSON_GetObjectItemCaseSensitive(o, "level");
+    const cJSON *sg = cJSON_GetObjectItemCaseSensitive(o, "segments");
+    const cJSON *pr = cJSON_GetObjectItemCaseSensitive(o, "profile");
+    if (strcmp(sh, "sphere") == 0) {
+        double level = lv ? (cJSON_IsNumber(lv) ? lv->valuedouble : -1) : 3;
+        if (!(level >= 0 && level <= 7 && level == floor(level))) return 0;
+        snprintf(what, n, "a sphere of level %d has", (int)level);
+        return 20ull << (2 * (int)level);
+    }
+    if (strcmp(sh, "revolution") == 0) {
+        double seg = sg ? (cJSON_IsNumber(sg) ? sg->valuedouble : -1) : 32;
+        int points = cJSON_IsArray(pr) ? cJSON_GetArraySize(pr) : 0;
+        if (!(seg >= 3 && seg <= 4096) || points < 2 || points > 100000) return 0;
+        snprintf(what, n, "%d profile points x %d segments make up to", points, (int)seg);
+        /* two triangles per segment per step and per cap ring */
+        return 2ull * (uint64_t)seg * (uint64_t)(points + 1);
+    }
+    snprintf(what, n, "the shape has");
+    return strcmp(sh, "box") == 0     ? 12
+           : strcmp(sh, "prism") == 0 ? 8
+           : strcmp(sh, "quad") == 0  ? 2
+                                      : 0;
+}
+
+/* Refuses a scene whose shapes make more than SCENE_MAX_TRIANGLES before any is built. */
+static int count_triangles_first(Ctx *c, const cJSON *j)
+{
+    uint64_t total = 0;
+    int i = 0;
+    for (const cJSON *o = j->child; o; o = o->next, i++) {
+        char what[128], p[PATH_MAX_LEN];
+        uint64_t n = shape_triangles(o, what, sizeof what);
+        total += n;
+        if (total <= SCENE_MAX_TRIANGLES) continue;
+        path_index(p, "objects", i);
+        return fail(c, p,
+                    "%s %llu triangles, %llu with the objects before it, and a scene may have at "
+                    "most %u: use fewer segments, profile points or a lower level",
+                    what, (unsigned long long)n, (unsigned long long)total, SCENE_MAX_TRIANGLES);
+    }
+    return 0;
+}
+
+static int check_hosts_disjoint(Ctx *c, const Scene *s);
+
 static int load_objects(Ctx *c, const cJSON *j, Scene *s)
 {
     if (!j) return fail(c, "objects", "missing (expected an array of objects)");
@@ -1053,6 +1231,7 @@ static int load_objects(Ctx *c, const cJSON *j, Scene *s)
     int n = cJSON_GetArraySize(j);
     if (n == 0) return fail(c, "objects", "the scene is empty: expected at least one object");
     if (n > 0x7fffffff / 2) return fail(c, "objects", "too many objects");
+    if (count_triangles_first(c, j)) return -1;
     s->objects = calloc((size_t)n, sizeof *s->objects);
     if (!s->objects) return fail(c, NULL, "out of memory");
     int i = 0;
@@ -1063,7 +1242,7 @@ static int load_objects(Ctx *c, const cJSON *j, Scene *s)
         s->nobjects = i + 1;
     }
     if (s->mesh.ntris == 0) return fail(c, "objects", "no triangles to render");
-    return 0;
+    return check_hosts_disjoint(c, s);
 }
 
 /* Signed crossings of the ray p + t*d (t > 0) with triangles [first, first+n) of the
@@ -1099,6 +1278,82 @@ static int signed_crossings(const Scene *s, uint32_t first, uint32_t n, const do
         count += det < 0.0 ? 1 : -1;
     }
     return count;
+}
+
+/* Whether object a has a vertex inside object b (both closed): a host nested in another. */
+static int vertex_inside(const Scene *s, const SceneObject *a, const SceneObject *b)
+{
+    static const double d[3] = {0.5773502691896258 + 0.0131, 0.5773502691896258 - 0.0217,
+                                0.5773502691896258 + 0.0071};
+    vec3 v = s->mesh.verts[s->mesh.tris[3 * a->first_tri]];
+    const double p[3] = {v.x, v.y, v.z};
+    return signed_crossings(s, b->first_tri, b->ntris, p, d) > 0;
+}
+
+static void object_bounds(const Scene *s, const SceneObject *o, vec3 *lo, vec3 *hi)
+{
+    *lo = v3(FLT_MAX, FLT_MAX, FLT_MAX);
+    *hi = v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+    for (uint32_t t = o->first_tri; t < o->first_tri + o->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            vec3 p = s->mesh.verts[s->mesh.tris[3 * t + k]];
+            *lo = v3_min(*lo, p);
+            *hi = v3_max(*hi, p);
+        }
+}
+
+/* Hosts (dielectric or textured objects) must not overlap: the medium the kernels track is
+ * one host at a time. Refused: surfaces that meet or touch (mesh_parts_meet, the exact test
+ * texgen uses for its elements) and one host inside another. Only hosts whose bounding box
+ * overlaps another host's are tested. */
+static int check_hosts_disjoint(Ctx *c, const Scene *s)
+{
+    int nh = 0, np = 0, *idx = malloc(sizeof(int) * 2 * (size_t)s->nobjects);
+    MeshPart *parts = malloc(sizeof *parts * (size_t)s->nobjects);
+    vec3 *box = malloc(sizeof *box * 2 * (size_t)s->nobjects);
+    int rc = (!idx || !parts || !box) ? fail(c, NULL, "out of memory") : 0;
+    int *pobj = idx ? idx + s->nobjects : NULL; /* per part: its object */
+    for (int i = 0; !rc && i < s->nobjects; i++)
+        if (s->objects[i].is_host) {
+            object_bounds(s, &s->objects[i], &box[2 * nh], &box[2 * nh + 1]);
+            idx[nh++] = i;
+        }
+    for (int i = 0; !rc && i < nh; i++) {
+        int near = 0;
+        for (int j = 0; !rc && j < nh; j++) {
+            vec3 l0 = box[2 * i], h0 = box[2 * i + 1], l1 = box[2 * j], h1 = box[2 * j + 1];
+            if (j == i || l0.x > h1.x || l1.x > h0.x || l0.y > h1.y || l1.y > h0.y || l0.z > h1.z ||
+                l1.z > h0.z)
+                continue;
+            near = 1;
+            const SceneObject *oi = &s->objects[idx[i]], *oj = &s->objects[idx[j]];
+            if (vertex_inside(s, oi, oj))
+                rc = fail(c, "objects",
+                          "%s is inside %s: dielectric and textured objects must not overlap "
+                          "(docs/scene-format.md)",
+                          diag_value(oi->name), diag_value(oj->name));
+        }
+        if (near) {
+            const SceneObject *o = &s->objects[idx[i]];
+            pobj[np] = idx[i];
+            parts[np++] = (MeshPart){&s->mesh, o->first_tri, o->ntris};
+        }
+    }
+    int pa, pb;
+    uint32_t ta, tb;
+    int meet = rc || np < 2 ? 0 : mesh_parts_meet(parts, np, &pa, &pb, &ta, &tb);
+    if (meet < 0) rc = fail(c, NULL, "out of memory");
+    if (meet > 0)
+        rc = fail(c, "objects",
+                  "%s and %s overlap (triangle %u of one meets triangle %u of the other): "
+                  "dielectric and textured objects must not overlap or touch "
+                  "(docs/scene-format.md)",
+                  diag_value(s->objects[pobj[pa]].name), diag_value(s->objects[pobj[pb]].name), ta,
+                  tb);
+    free(idx);
+    free(parts);
+    free(box);
+    return rc;
 }
 
 void scene_medium_at(const Scene *s, vec3 p, VbMedium *m)
@@ -1149,17 +1404,31 @@ static int anim_value(Ctx *c, const cJSON *j, const char *path, AnimValue *out)
     return 0;
 }
 
+/* A track's target path: 1 to PATH_MAX_LEN - 1 characters, no empty component
+ * ("camera..fov" is not "camera.fov"). */
+static int check_target(Ctx *c, const char *target, const char *path)
+{
+    if (strlen(target) >= PATH_MAX_LEN || !*target)
+        return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+    if (target[0] == '.' || target[strlen(target) - 1] == '.' || strstr(target, ".."))
+        return fail(c, path, "\"%s\": an empty component (expected names between the dots)",
+                    diag_value(target));
+    return 0;
+}
+
 /* Sets the member a track's target names, "materials.glass.eta" or "objects.ball.transform.
  * rotate", to val (taken over; NULL only checks the path): object members by key, array
  * elements by index or by their "name". A missing last member is created (a setting left at
  * its default), and so are missing objects on the way inside an element of an array (an
  * object's transform); anything else must exist. */
-static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val)
+static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val,
+                    char *canon)
 {
     char buf[PATH_MAX_LEN];
-    if (strlen(target) >= sizeof buf || !*target) {
+    canon[0] = 0;
+    if (check_target(c, target, path)) {
         cJSON_Delete(val);
-        return fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+        return -1;
     }
     strcpy(buf, target);
     cJSON *node = root;
@@ -1172,7 +1441,7 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             return fail(c, path,
                         "\"%s\": expected a value inside image, camera, render, lights, "
                         "materials or objects",
-                        target);
+                        diag_value(target));
         }
         int index = -1;
         cJSON *next = NULL;
@@ -1188,26 +1457,32 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
             }
             if (index < 0) {
                 cJSON_Delete(val);
-                return fail(c, path, "\"%s\": no element \"%s\" (an index or a name)", target, seg);
+                return fail(c, path, "\"%s\": no element \"%s\" (an index or a name)",
+                            diag_value(target), diag_value(seg));
             }
             next = cJSON_GetArrayItem(node, index);
             in_element = 1;
+            size_t k = strlen(canon);
+            snprintf(canon + k, PATH_MAX_LEN - k, "[%d]", index);
         } else if (cJSON_IsObject(node)) {
             next = cJSON_GetObjectItemCaseSensitive(node, seg);
+            size_t k = strlen(canon);
+            snprintf(canon + k, PATH_MAX_LEN - k, "%s%s", k ? "." : "", seg);
             if (!next && node == root) {
                 cJSON_Delete(val);
-                return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+                return fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
+                            diag_value(seg));
             }
         } else {
             cJSON_Delete(val);
-            return fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array", target,
-                        seg, json_type_name(node));
+            return fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array",
+                        diag_value(target), diag_value(seg), json_type_name(node));
         }
         if (last) {
             if (next && !cJSON_IsNumber(next) && !cJSON_IsArray(next)) {
                 cJSON_Delete(val);
                 return fail(c, path, "\"%s\" is a %s: only numbers and arrays of numbers animate",
-                            target, json_type_name(next));
+                            diag_value(target), json_type_name(next));
             }
             if (!val) return 0;
             cJSON_bool ok = index >= 0 ? cJSON_ReplaceItemInArray(node, index, val)
@@ -1221,7 +1496,7 @@ static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, c
         }
         if (!next && !in_element) {
             cJSON_Delete(val);
-            return fail(c, path, "\"%s\": no member \"%s\"", target, seg);
+            return fail(c, path, "\"%s\": no member \"%s\"", diag_value(target), diag_value(seg));
         }
         if (!next) {            /* a missing object on the way, inside an element (its transform) */
             if (!val) return 0; /* checking only: it would be created */
@@ -1258,6 +1533,8 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
     const cJSON *tracks = cJSON_GetObjectItemCaseSensitive(a, "tracks");
     if (!cJSON_IsArray(tracks) || cJSON_GetArraySize(tracks) < 1)
         return fail(c, "animation.tracks", "expected an array of {\"target\", \"keys\"}");
+    c->targets = calloc((size_t)cJSON_GetArraySize(tracks), sizeof *c->targets);
+    if (!c->targets) return fail(c, NULL, "out of memory");
     for (int ti = 0; ti < cJSON_GetArraySize(tracks); ti++) {
         const cJSON *t = cJSON_GetArrayItem(tracks, ti);
         char p[PATH_MAX_LEN], q[PATH_MAX_LEN], kp[PATH_MAX_LEN];
@@ -1298,7 +1575,7 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
         }
         if (fhi < flo || frame <= flo) hi = lo, fhi = flo; /* before the first key: hold it */
         if (frame < 0) {
-            if (anim_set(c, root, target->valuestring, q, NULL)) return -1;
+            if (anim_set(c, root, target->valuestring, q, NULL, c->targets[ti])) return -1;
             continue;
         }
         double w = fhi > flo ? (frame - flo) / (fhi - flo) : 0.0;
@@ -1308,7 +1585,8 @@ static int anim_apply(Ctx *c, cJSON *root, int frame, int *frames)
         for (int i = 0; i < n; i++) out[i] = lo.v[i] + w * (hi.v[i] - lo.v[i]);
         cJSON *val = lo.n ? cJSON_CreateDoubleArray(out, lo.n) : cJSON_CreateNumber(out[0]);
         if (!val) return fail(c, NULL, "out of memory");
-        if (anim_set(c, root, target->valuestring, q, val)) return -1;
+        if (anim_set(c, root, target->valuestring, q, val, c->targets[ti])) return -1;
+        c->ntargets = ti + 1;
     }
     return 0;
 }
@@ -1320,79 +1598,154 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen)
 
 int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t errlen)
 {
+    char *text = NULL;
+    memset(s, 0, sizeof *s);
+    if (scene_read_text(path, &text, err, errlen)) return 2;
+    int rc = scene_load_text(path, text, frame, s, err, errlen);
+    free(text);
+    return rc;
+}
+
+/* The error at the position `at` of text: "FILE:LINE:COL: message". */
+static int fail_at(const Ctx *c, const char *text, const char *at, const char *msg)
+{
+    int line, col;
+    text_position(text, at, &line, &col);
+    diag_format(c->err, c->errlen, "%s:%d:%d: %s", c->file, line, col, msg);
+    return -1;
+}
+
+/* A string at s (just past its opening quote) holding \u0000: cJSON would cut it there, so
+ * "fov\u0000zoom" would read as "fov". Reported as an unknown key or a bad string. */
+static int fail_nul_string(const Ctx *c, const char *text, const char *s)
+{
+    const char *e = s;
+    while (*e && *e != '"') e += (*e == '\\' && e[1]) ? 2 : 1;
+    const char *after = *e ? e + 1 : e;
+    while (*after == ' ' || *after == '\t' || *after == '\r' || *after == '\n') after++;
+    char raw[128], msg[512];
+    snprintf(raw, sizeof raw, "%.*s", (int)(e - s < 100 ? e - s : 100), s);
+    if (*after == ':')
+        snprintf(msg, sizeof msg, "unknown key \"%s\" (a key cannot hold \\u0000)",
+                 diag_value(raw));
+    else
+        snprintf(msg, sizeof msg, "JSON string \"%s\" holds \\u0000 (NUL), which is not allowed",
+                 diag_value(raw));
+    return fail_at(c, text, s - 1, msg);
+}
+
+/* What cJSON accepts but JSON does not, or reads otherwise than written: numbers with
+ * leading zeros (040) and strings holding \u0000. Checked on the raw text, with line:col. */
+static int check_raw_text(const Ctx *c, const char *text)
+{
+    char prev = ' ';
+    for (const char *p = text; *p; p++) {
+        if (*p == '"') { /* a whole string: escapes skipped, \u0000 refused */
+            const char *q = p + 1;
+            while (*q && *q != '"') {
+                if (*q == '\\' && strncmp(q + 1, "u0000", 5) == 0)
+                    return fail_nul_string(c, text, p + 1);
+                q += (*q == '\\' && q[1]) ? 2 : 1;
+            }
+            if (!*q) return 0; /* unterminated: the parser reports it */
+            p = q;
+            prev = '"';
+            continue;
+        }
+        int starts = (*p == '-' || isdigit((unsigned char)*p)) &&
+                     !(isalnum((unsigned char)prev) || prev == '.' || prev == '+' || prev == '-');
+        const char *d = *p == '-' ? p + 1 : p;
+        if (starts && d[0] == '0' && isdigit((unsigned char)d[1]))
+            return fail_at(c, text, d,
+                           "JSON syntax error: a number cannot start with 0 (write 40, not 040)");
+        prev = *p;
+    }
+    return 0;
+}
+
+/* Parses text into *root, or writes "FILE:LINE:COL: JSON syntax error ..." into err. */
+static int parse_json(const Ctx *c, const char *text, cJSON **root)
+{
+    const char *end = NULL;
+    *root = cJSON_ParseWithOpts(text, &end, 1);
+    if (*root) return 0;
+    const char *at = end ? end : cJSON_GetErrorPtr();
+    int line, col;
+    if (!at) at = text;
+    text_position(text, at, &line, &col);
+    char near[24] = "";
+    size_t k = 0;
+    for (const char *q = at; *q && *q != '\n' && k < 16; q++) near[k++] = *q;
+    near[k] = 0;
+    if (*at == 0)
+        diag_format(c->err, c->errlen, "%s:%d:%d: JSON syntax error: unexpected end of file",
+                    c->file, line, col);
+    else
+        diag_format(c->err, c->errlen, "%s:%d:%d: JSON syntax error near \"%s\"", c->file, line,
+                    col, near);
+    return -1;
+}
+
+/* Everything inside the document root, for the frame anim_apply has set. */
+static int load_document(Ctx *c, const cJSON *root, Scene *s)
+{
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (!cam) return fail(c, "camera", "missing (expected an object with eye and look_at)");
+    const cJSON *img = cJSON_GetObjectItemCaseSensitive(root, "image");
+    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (desc && !cJSON_IsString(desc))
+        return fail(c, "description", "expected a string, got %s", json_type_name(desc));
+    if (img) {
+        if (load_image(c, img, s)) return -1;
+    } else {
+        s->width = s->height = 400;
+    }
+    if (load_camera(c, cam, s) ||
+        load_render(c, cJSON_GetObjectItemCaseSensitive(root, "render"), s) ||
+        load_lights(c, cJSON_GetObjectItemCaseSensitive(root, "lights"), s) ||
+        load_materials(c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
+        load_objects(c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
+        return -1;
+    default_band_layout(cJSON_GetObjectItemCaseSensitive(root, "render"), s);
+    return 0;
+}
+
+int scene_load_text(const char *path, const char *text, int frame, Scene *s, char *err,
+                    size_t errlen)
+{
     static const char *const keys[] = {"description", "image",   "camera",    "render", "lights",
                                        "materials",   "objects", "animation", NULL};
-    Ctx c = {path, err, errlen, 0};
+    Ctx c = {.file = scene_display_name(path), .err = err, .errlen = errlen, .frame = frame};
     memset(s, 0, sizeof *s);
     mesh_init(&s->mesh);
-    char *text = NULL;
     cJSON *root = NULL;
-    if (!(s->path = dup_string(path))) goto oom;
-    if (!(s->dir = dup_string(path))) goto oom;
+    if (!(s->path = dup_string(path)) || !(s->dir = dup_string(is_stdin(path) ? "" : path)))
+        goto oom;
     char *slash = strrchr(s->dir, '/');
     if (slash)
         *(slash == s->dir ? slash + 1 : slash) = 0;
     else
         s->dir[0] = 0;
-    if (read_file(&c, path, &text)) goto fail;
-    const char *end = NULL;
-    root = cJSON_ParseWithOpts(text, &end, 1);
-    if (!root) {
-        const char *at = end ? end : cJSON_GetErrorPtr();
-        int line, col;
-        if (!at) at = text;
-        text_position(text, at, &line, &col);
-        char near[24] = "";
-        size_t k = 0;
-        for (const char *q = at; *q && *q != '\n' && k < 16; q++) near[k++] = *q;
-        near[k] = 0;
-        if (*at == 0)
-            snprintf(err, errlen, "%s:%d:%d: JSON syntax error: unexpected end of file", path, line,
-                     col);
-        else
-            snprintf(err, errlen, "%s:%d:%d: JSON syntax error near \"%s\"", path, line, col, near);
-        goto fail;
-    }
+    if (check_raw_text(&c, text) || parse_json(&c, text, &root)) goto fail;
     if (expect_object(&c, root, "") || check_keys(&c, root, "", keys) ||
         anim_apply(&c, root, frame, &s->frames))
         goto fail;
     if (frame >= s->frames) {
+        c.frame = -1;
         fail(&c, "animation.frames", "frame %d asked for, the scene has %d", frame, s->frames);
         goto fail;
     }
     s->frame = frame < 0 ? 0 : frame;
     s->animated = c.animated;
-    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
-    if (!cam) {
-        fail(&c, "camera", "missing (expected an object with eye and look_at)");
-        goto fail;
-    }
-    const cJSON *img = cJSON_GetObjectItemCaseSensitive(root, "image");
-    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
-    if (desc && !cJSON_IsString(desc)) {
-        fail(&c, "description", "expected a string, got %s", json_type_name(desc));
-        goto fail;
-    }
-    if (img) {
-        if (load_image(&c, img, s)) goto fail;
-    } else {
-        s->width = s->height = 400;
-    }
-    if (load_camera(&c, cam, s) ||
-        load_render(&c, cJSON_GetObjectItemCaseSensitive(root, "render"), s) ||
-        load_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights"), s) ||
-        load_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials"), s) ||
-        load_objects(&c, cJSON_GetObjectItemCaseSensitive(root, "objects"), s))
-        goto fail;
-    default_band_layout(cJSON_GetObjectItemCaseSensitive(root, "render"), s);
+    if (load_document(&c, root, s)) goto fail;
     cJSON_Delete(root);
-    free(text);
+    free(c.targets);
     return 0;
 oom:
-    snprintf(err, errlen, "%s: out of memory", path);
+    diag_format(err, errlen, "%s: out of memory", c.file);
 fail:
     cJSON_Delete(root);
-    free(text);
+    free(c.targets);
     scene_free(s);
     return 2;
 }

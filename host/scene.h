@@ -11,9 +11,10 @@
 #include "mesh.h"
 #include "types.h"
 
-#define SCENE_MAX_IMAGE     16384
-#define SCENE_MAX_TRIANGLES 50000000u
-#define SCENE_NAME_MAX      64
+#define SCENE_MAX_IMAGE      16384
+#define SCENE_MAX_TRIANGLES  50000000u
+#define SCENE_NAME_MAX       64
+#define SCENE_MAX_FILE_BYTES ((size_t)1 << 30) /* scene and mesh files: at most 1 GiB */
 
 /* A material's surface pattern as the scene gives it; the renderer turns it into a
  * VbPattern (Fourier coefficients, image texels). */
@@ -35,6 +36,7 @@ typedef struct SceneMaterial {
 
 typedef struct SceneObject {
     char name[SCENE_NAME_MAX]; /* the JSON path ("objects[2]") when not named */
+    int named;                 /* the scene gave "name" (unique among the objects) */
     int material;
     int is_host;      /* a closed volume tracked by the medium state (dielectric or textured) */
     int tex_slot;     /* -1: no volume texture */
@@ -106,6 +108,20 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen);
  * not animated); a frame beyond them is an error. */
 int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t errlen);
 
+/* Reads a scene file whole, exactly once (a named pipe or standard input cannot be read
+ * twice): "-" and "/dev/stdin" read standard input. At most SCENE_MAX_FILE_BYTES, no NUL
+ * byte. Returns 0 with *text malloc'ed, or 2 with a message. */
+int scene_read_text(const char *path, char **text, char *err, size_t errlen);
+
+/* scene_load_frame on text already read from path: path names the scene in messages
+ * ("-" as "<stdin>") and its directory is where relative mesh paths start (the current
+ * directory for "-" and "/dev/stdin"). */
+int scene_load_text(const char *path, const char *text, int frame, Scene *s, char *err,
+                    size_t errlen);
+
+/* The name messages give the scene file at path: "<stdin>" for "-". */
+const char *scene_display_name(const char *path);
+
 /* Frees everything scene_load allocated. */
 void scene_free(Scene *s);
 
@@ -114,7 +130,8 @@ void scene_free(Scene *s);
  * of a ray from p in double precision. */
 void scene_medium_at(const Scene *s, vec3 p, VbMedium *m);
 
-/* Parses a grid resolution as written on the command line: "auto", "N" or "NX,NY,NZ".
+/* Parses a grid resolution as written on the command line: "auto", "N" or "NX,NY,NZ"
+ * (1..GRID_MAX_AXIS each, at most GRID_MAX_CELLS in all).
  * Returns 0 and sets res (all 0 for auto), or -1. */
 int scene_parse_grid(const char *text, int res[3]);
 

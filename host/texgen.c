@@ -10,6 +10,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "diag.h"
 #include "image_io.h"
 
 static const char usage_main[] =
@@ -92,12 +93,14 @@ static size_t quiet_len;
 static int report(int status, const char *method, const char *fmt, va_list ap)
 {
     char msg[768];
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    diag_vformat(msg, sizeof msg, fmt, ap);
     if (quiet_err) {
         if (!quiet_err[0])
             snprintf(quiet_err, quiet_len, "%s%s%s", method ? method : "", method ? ": " : "", msg);
     } else {
-        fprintf(stderr, "vbcl texgen%s%s: %s\n", method ? " " : "", method ? method : "", msg);
+        char prefix[64];
+        snprintf(prefix, sizeof prefix, "vbcl texgen%s%s", method ? " " : "", method ? method : "");
+        diag_print(prefix, "%s", msg);
     }
     return status;
 }
@@ -434,10 +437,7 @@ static int cmd_fourier(int argc, char **argv)
     VbFourier f;
     if (texgen_fourier_init(&f, terms, a0, freq, seed, err, sizeof err)) return fail(M, "%s", err);
     float *rgba = malloc((size_t)pixels * (size_t)pixels * 4 * sizeof *rgba);
-    if (!rgba) {
-        fprintf(stderr, "vbcl texgen fourier: out of memory for a %d x %d image\n", pixels, pixels);
-        return 1;
-    }
+    if (!rgba) return fail_io(M, "out of memory for a %d x %d image", pixels, pixels);
     for (int y = 0; y < pixels; y++)
         for (int x = 0; x < pixels; x++) {
             float X = extent * (x + 0.5f) / pixels, Y = extent * (pixels - y - 0.5f) / pixels;
@@ -449,10 +449,7 @@ static int cmd_fourier(int argc, char **argv)
         }
     int rc = image_write(out, pixels, pixels, rgba, 0.0f, err, sizeof err);
     free(rgba);
-    if (rc) {
-        fprintf(stderr, "vbcl texgen fourier: %s\n", err);
-        return 1;
-    }
+    if (rc) return fail_io(M, "%s", err);
     printf("%s: G(X, Y, %g) on [0, %g]^2, %d terms, C_1 = %.6g, A_0 = %g\n", out, z, extent, terms,
            f.c[0], a0);
     return 0;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "image_io.h"
@@ -31,7 +32,7 @@ static int file_exists(const char *path)
 static int vbcl(const char *args, char *out, size_t n)
 {
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s %s", tu_vbcl, args);
+    snprintf(cmd, sizeof cmd, "timeout 300 %s %s", tu_vbcl, args); /* a hang fails (124) */
     return tu_run(cmd, out, n);
 }
 
@@ -300,12 +301,132 @@ static void test_cli_bad_input_classes(void)
           "missing scene: %s", out);
 }
 
+/* A scene read through a pipe (issue 17): a named pipe and "-" are read exactly once (a
+ * second open would wait forever); with "-" mesh paths start at the current directory. */
+static void test_cli_scene_from_pipe(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file("piped.json", GOOD_SCENE);
+    char cmd[4096], out[8192], img[512];
+    snprintf(img, sizeof img, "%s/piped.png", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             "cd %s && rm -f fifo.json && mkfifo fifo.json && (cat %s > fifo.json &) && "
+             "timeout 60 %s%s fifo.json -q -o %s",
+             tu_tmpdir(), scene, tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, img);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && file_exists(img), "a named pipe renders (%d): %s", rc, out);
+    /* "-": the mesh tri.obj is found in the current directory */
+    tu_write_file("pipe_tri.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    const char *mesh_scene = tu_write_file("pipe_mesh.json", MESH_SCENE("pipe_tri.obj"));
+    remove(img);
+    snprintf(cmd, sizeof cmd, "cd %s && timeout 60 %s%s - -q -o %s --width 8 --height 8 < %s",
+             tu_tmpdir(), tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, img, mesh_scene);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && file_exists(img), "- with a relative mesh renders (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "cat %s | timeout 60 %s /dev/stdin -q -o %s --width 8 --height 8",
+             scene, tu_vbcl, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "/dev/stdin from a pipe renders (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "printf '{\"camera\": ' | timeout 60 %s - -o %s", tu_vbcl, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "<stdin>:1:12: JSON syntax error"), "bad scene on stdin: %s", out);
+}
+
+/* Every output path is checked before any work (issue 17): a missing directory for the
+ * image, the --aa-map or a frame exits 2 naming the path as given, writing nothing. */
+static void test_cli_outputs_checked_first(void)
+{
+    const char *scene = tu_write_file("out_good.json", GOOD_SCENE);
+    char args[2048], out[8192], img[512];
+    snprintf(img, sizeof img, "%s/checked.png", tu_tmpdir());
+    remove(img);
+    snprintf(args, sizeof args, "%s -o %s --aa 0.1 --aa-map %s/nodir/map.png", scene, img,
+             tu_tmpdir());
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nodir/map.png: cannot write there") && !file_exists(img),
+          "missing --aa-map directory: nothing rendered (%d): %s", rc, out);
+    snprintf(args, sizeof args, "%s -o %s/nodir/x.png", scene, tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nodir/x.png: cannot write there") && !strstr(out, ".tmp"),
+          "missing -o directory named as given (%d): %s", rc, out);
+    expect_bad(GOOD_SCENE, "-o /proc/nodir/x.exr", "/proc/nodir/x.exr");
+}
+
+/* An animation whose frame 1 is out of range fails before frame 0 is written, naming the
+ * track and the frame (issue 17). */
+static void test_cli_animation_checked_first(void)
+{
+    const char *scene = tu_write_file(
+        "anim_bad.json",
+        "{\"image\": {\"width\": 8, \"height\": 8},"
+        " \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+        " \"materials\": {\"m\": {}}, \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}],"
+        " \"animation\": {\"frames\": 2, \"tracks\": [{\"target\": \"camera.fov\","
+        "   \"keys\": [[0, 40], [1, 400]]}]}}");
+    char args[2048], out[8192], path[512];
+    snprintf(path, sizeof path, "%s/animbad_0.png", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s/animbad_#.png", scene, tu_tmpdir());
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "animation.tracks[0] at frame 1: camera.fov: 400 is out of range"),
+          "frame 1 named (%d): %s", rc, out);
+    CHECK(!file_exists(path), "frame 0 not written");
+}
+
+/* A mesh must be a regular file of at most 1 GiB (issue 17): a link to /dev/zero grew
+ * memory until the machine ran out; a pipe would wait forever. */
+static void test_cli_mesh_files_capped(void)
+{
+    char path[512], cmd[1024];
+    snprintf(path, sizeof path, "%s/zero.obj", tu_tmpdir());
+    remove(path);
+    if (symlink("/dev/zero", path)) CHECK(0, "symlink %s", path);
+    snprintf(cmd, sizeof cmd,
+             "cd %s && rm -f fifo.obj && mkfifo fifo.obj && truncate -s 1100M big.obj",
+             tu_tmpdir());
+    CHECK(tu_run(cmd, NULL, 0) == 0, "mkfifo and truncate");
+    expect_bad(MESH_SCENE("zero.obj"), NULL, "zero.obj: not a regular file");
+    expect_bad(MESH_SCENE("fifo.obj"), NULL, "fifo.obj: not a regular file");
+    expect_bad(MESH_SCENE("big.obj"), NULL,
+               "big.obj: 1153433600 bytes, more than the limit of 1 GiB");
+}
+
+/* Control characters in a file name, an argument or a key appear as \xNN, and a huge
+ * value is cut: every message stays one harmless line (issue 17). */
+static void test_cli_messages_escaped(void)
+{
+    char cmd[2048], out[8192];
+    snprintf(cmd, sizeof cmd, "%s \"$(printf '%s/a\\nb\\033[31m.json')\"", tu_vbcl, tu_tmpdir());
+    int rc = tu_run(cmd, out, sizeof out);
+    char *nl = strchr(out, '\n');
+    CHECK(rc == 2 && strstr(out, "a\\x0ab\\x1b[31m.json"), "file name escaped (%d): %s", rc, out);
+    CHECK(nl && nl[1] == 0 && !strchr(out, '\033'), "one line, no raw ESC: %s", out);
+    snprintf(cmd, sizeof cmd, "%s x.json --width \"$(head -c 100000 /dev/zero | tr '\\0' 9)\"",
+             tu_vbcl);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--width 999") && strstr(out, "...") && strlen(out) < 300,
+          "a 100,000-character value is cut (%d, %zu characters): %.300s", rc, strlen(out), out);
+    snprintf(cmd, sizeof cmd, "%s x.json \"$(printf -- '--e\\033]0;x\\007')\"", tu_vbcl);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--e\\x1b]0;x\\x07") && !strchr(out, '\033'),
+          "unknown option escaped (%d): %s", rc, out);
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0], \"z\\u001b[2J\": 2}}", NULL,
+               "camera.z\\x1b[2J");
+}
+
 void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);
+    RUN_TEST(test_cli_messages_escaped);
+    RUN_TEST(test_cli_scene_from_pipe);
+    RUN_TEST(test_cli_outputs_checked_first);
+    RUN_TEST(test_cli_animation_checked_first);
+    RUN_TEST(test_cli_mesh_files_capped);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
 }

@@ -130,6 +130,24 @@ static void test_dispersion_scene_keys(void)
         CHECK(rc == 2 && strstr(err, "materials.g.dispersion"), "%s: rc %d: %s", bad[i], rc, err);
         if (rc == 0) scene_free(&s);
     }
+    /* an index that is not a finite number > 0 somewhere in 380..780 nm (issue 17): a
+     * Sellmeier pole at 548 nm (eta squared < 0 from 388 nm), one at 600 nm (from 425 nm),
+     * a jump that takes eta below 0 */
+    const char *nan[][2] = {
+        {"{\"model\":\"sellmeier\",\"B\":[1,0,0],\"C\":[0.3,0,0]}", "at 388 nm"},
+        {"{\"model\":\"sellmeier\",\"B\":[1,0,0],\"C\":[0.36,0,0]}", "at 425 nm"},
+        {"{\"model\":\"cauchy\",\"abbe\":40,\"band\":[500,550],\"jump\":-3}", "at 526 nm"}};
+    for (size_t i = 0; i < sizeof nan / sizeof nan[0]; i++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "{\"camera\":{\"eye\":[0,0,5],\"look_at\":[0,0,0]},\"materials\":{\"g\":{"
+                 "\"dispersion\":%s}},\"objects\":[{\"shape\":\"sphere\",\"material\":\"g\"}]}",
+                 nan[i][0]);
+        rc = scene_load(tu_write_file("disp_nan.json", text), &s, err, sizeof err);
+        CHECK(rc == 2 && strstr(err, "materials.g.dispersion: eta") && strstr(err, nan[i][1]),
+              "%s: rc %d: %s", nan[i][0], rc, err);
+        if (rc == 0) scene_free(&s);
+    }
 }
 
 #define RAD (3.14159265358979323846 / 180.0)

@@ -111,6 +111,39 @@ static void test_scene_bad_syntax(void)
     expect_error("{\"camera\": {}} trailing", "scene.json:1:", "syntax");
 }
 
+/* What cJSON accepts but JSON does not, or reads otherwise than written (issue 17): a key
+ * holding \u0000 ("fov\u0000zoom" would read as "fov"), numbers with leading zeros. */
+static void test_scene_raw_json(void)
+{
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0],\n"
+                 "  \"fov\\u0000zoom\": 30}}",
+                 "scene.json:2:3: unknown key \"fov\\u0000zoom\"", NULL);
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0],\n  \"fov\": 040}}",
+                 "scene.json:2:10: JSON syntax error", "start with 0");
+    expect_error("{\"camera\": {\"eye\": [0, 0, -05], \"look_at\": [0, 0, 0]}}",
+                 "scene.json:1:28: JSON syntax error", "start with 0");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"mesh\", \"material\": \"m\", "
+                                "\"file\": \"a.obj\\u0000.ply\"}]}",
+                 "scene.json:3:", "\\u0000");
+    /* a track path with an empty component is not read as "camera.fov" */
+    expect_error(MIN_SCENE_HEAD " \"objects\": [], \"animation\": {\"frames\": 2, \"tracks\":"
+                                " [{\"target\": \"camera..fov\", \"keys\": [[0, 30]]}]}}",
+                 "animation.tracks[0].target", "empty component");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [], \"animation\": {\"frames\": 2, \"tracks\":"
+                                " [{\"target\": \".camera.fov\", \"keys\": [[0, 30]]}]}}",
+                 "animation.tracks[0].target", "empty component");
+    /* what stays valid: 0, -0.5, 1e05, 0e1, and digits inside strings */
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(MIN_SCENE_HEAD " \"render\": {\"seed\": 0, \"min_weight\": 1e-05,"
+                                      " \"ambient\": [0, 0.05, 0e1]},"
+                                      " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                      " \"name\": \"007\", \"centre\": [-0.5, 0, 1e05]}]}",
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "valid numbers load: %s", err);
+    if (rc == 0) scene_free(&s);
+}
+
 static void test_scene_unknown_keys(void)
 {
     expect_error(MIN_SCENE_HEAD " \"objects\": [], \"lihgts\": []}", "lihgts", "unknown key");
@@ -156,6 +189,13 @@ static void test_scene_out_of_range(void)
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"radius\": -1}]}",
                  "objects[0].radius", "out of range");
+    /* limits read as written: integers whole, open intervals as "> 0" */
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"seed\": 3000000000}}",
+                 "render.seed: 3000000000 is out of range [0, 2147483647]", NULL);
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
+                                "\"radius\": -1}]}",
+                 "objects[0].radius: -1 is out of range: expected > 0", NULL);
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"level\": 40}]}",
                  "objects[0].level", "out of range");
@@ -224,6 +264,13 @@ static void test_scene_parse_grid(void)
     CHECK(scene_parse_grid("0", r) == -1, "zero rejected");
     CHECK(scene_parse_grid("5000", r) == -1, "too large rejected");
     CHECK(scene_parse_grid("x", r) == -1, "text rejected");
+    /* each axis in range but 2^30 cells in all: refused when read, saying what to do */
+    CHECK(scene_parse_grid("1024", r) == -1, "1024^3 rejected");
+    CHECK(scene_parse_grid("1024,1024,128", r) == 0, "2^27 cells accepted");
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"grid\": [1024, 1024, 1024]}}",
+                 "scene.json: render.grid: 1024x1024x1024 is 1073741824 cells, more than the limit",
+                 "use \"auto\" or fewer cells");
 }
 
 /* A texture generated inline from texgen's arguments: generated once into the cache,
@@ -285,6 +332,107 @@ static void test_scene_texture_generate_inline(void)
         " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
         "   \"texture\": {\"generate\": \"bomb\", \"file\": \"a.obj\", \"material\": \"m\"}}]}",
         "objects[0].texture", "not both");
+    /* Fourier synthesis and projection make images, surface patterns (issue 17) */
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \"fourier --terms 5\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate: texgen fourier makes an image, a surface pattern",
+                 "\"pattern\" {\"type\": \"fourier\"}");
+    expect_error(MIN_SCENE_HEAD
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                 "   \"texture\": {\"generate\": \" project x.png\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "{\"type\": \"projection\"}");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                "   \"texture\": {\"generate\": \"bombs\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "expected \"bomb ...\" or \"deform ...\"");
+}
+
+/* Every shape's triangle count is known from its parameters, and the scene is refused
+ * before any is built (issue 17): 13,000 profile points x 4,096 segments once took 5 GB
+ * and 20 s, 200 spheres of level 7 took 27 s and 1.5 GB. */
+static void test_scene_triangles_counted_first(void)
+{
+    size_t cap = 13000 * 24 + 1024, len = 0;
+    char *text = malloc(cap);
+    if (!text) return;
+    len += (size_t)snprintf(text, cap, "%s",
+                            MIN_SCENE_HEAD " \"objects\": [{\"shape\": "
+                                           "\"revolution\", \"material\": \"m\", "
+                                           "\"segments\": 4096, \"profile\": [");
+    for (int i = 0; i < 13000; i++)
+        len += (size_t)snprintf(text + len, cap - len, "%s[%d, %d]", i ? "," : "", 1 + i % 2, i);
+    snprintf(text + len, cap - len, "]}]}");
+    double t0 = clu_now_ms();
+    expect_error(text, "objects[0]: 13000 profile points x 4096 segments make up to", "fewer");
+    double ms = clu_now_ms() - t0;
+    CHECK(ms < 3000, "refused in %.0f ms, before tessellating", ms);
+    /* 200 spheres of level 7: the 153rd passes the limit, found before the first is built */
+    len = (size_t)snprintf(text, cap, "%s", MIN_SCENE_HEAD " \"objects\": [");
+    for (int i = 0; i < 200; i++)
+        len += (size_t)snprintf(text + len, cap - len,
+                                "%s{\"shape\": \"sphere\", \"level\": 7, \"material\": \"m\"}",
+                                i ? "," : "");
+    snprintf(text + len, cap - len, "]}");
+    t0 = clu_now_ms();
+    expect_error(text, "objects[152]: a sphere of level 7 has 327680 triangles, 50135040 with",
+                 NULL);
+    ms = clu_now_ms() - t0;
+    CHECK(ms < 3000, "refused in %.0f ms, before tessellating", ms);
+    free(text);
+}
+
+/* Dielectric and textured objects must not overlap (issue 17): surfaces that meet or touch,
+ * or one inside the other, name both objects; apart, or overlapping an opaque object, load. */
+static void test_scene_hosts_disjoint(void)
+{
+#define GLASS_SCENE(objs)                                                                          \
+    "{\"camera\": {\"eye\": [0, 0, 9], \"look_at\": [0, 0, 0]},"                                   \
+    " \"materials\": {\"m\": {}, \"g\": {\"k_global\": 1, \"eta\": 1.5}}, \"objects\": [" objs     \
+    "]}"
+    expect_error(
+        GLASS_SCENE("{\"shape\": \"box\", \"material\": \"m\"},"
+                    " {\"name\": \"left\", \"shape\": \"sphere\", \"material\": \"g\"},"
+                    " {\"shape\": \"sphere\", \"material\": \"g\", \"centre\": [1.5, 0, 0]}"),
+        "objects: left and objects[2] overlap", "must not overlap");
+    expect_error(GLASS_SCENE("{\"name\": \"outer\", \"shape\": \"sphere\", \"material\": \"g\","
+                             "  \"radius\": 2},"
+                             " {\"name\": \"inner\", \"shape\": \"box\", \"material\": \"g\"}"),
+                 "objects: inner is inside outer", NULL);
+    expect_error(GLASS_SCENE("{\"name\": \"a\", \"shape\": \"box\", \"material\": \"g\"},"
+                             " {\"name\": \"b\", \"shape\": \"box\", \"material\": \"g\","
+                             "  \"transform\": {\"translate\": [1, 0, 0]}}"),
+                 "objects: a and b overlap", "or touch");
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(GLASS_SCENE("{\"shape\": \"box\", \"material\": \"m\", \"size\": [3, 3, 3]},"
+                                   " {\"shape\": \"sphere\", \"material\": \"g\"},"
+                                   " {\"shape\": \"sphere\", \"material\": \"g\","
+                                   "  \"centre\": [2.01, 0, 0]}"),
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "apart, and inside an opaque box: loads: %s", err);
+    if (rc == 0) scene_free(&s);
+#undef GLASS_SCENE
+}
+
+/* Object names are unique: an animation track finds an object by its name (issue 17). */
+static void test_scene_duplicate_names(void)
+{
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"a\", \"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"b\", \"shape\": \"sphere\", \"material\": \"m\"},\n"
+                                "  {\"name\": \"a\", \"shape\": \"box\", \"material\": \"m\"}],\n"
+                                " \"animation\": {\"frames\": 2, \"tracks\": [{\"target\":"
+                                " \"objects.a.transform.scale\", \"keys\": [[0, 1], [1, 2]]}]}}",
+                 "objects[3].name: \"a\" is already used by objects[1]", NULL);
+    /* an unnamed object is known by its path, which a name may repeat harmlessly */
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"},"
+                                      " {\"name\": \"objects[0]\", \"shape\": \"box\", "
+                                      "\"material\": \"m\"}]}",
+                       &s, err, sizeof err);
+    CHECK(rc == 0, "distinct names load: %s", err);
+    if (rc == 0) scene_free(&s);
 }
 
 /* Every example scene in the repository loads (meshes, textures and all). */
@@ -394,8 +542,9 @@ static void test_scene_animation(void)
     rc = scene_load_frame(hot, 0, &s, err, sizeof err);
     CHECK(rc == 0, "frame 0: %s", err);
     if (rc == 0) scene_free(&s);
-    CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 && strstr(err, "materials.m.k_global"),
-          "frame 3: %s", err);
+    CHECK(scene_load_frame(hot, 3, &s, err, sizeof err) == 2 &&
+              strstr(err, "animation.tracks[0] at frame 3: materials.m.k_global: 2.5 is out of"),
+          "frame 3 names the track and the frame: %s", err);
 #undef ANIM_BAD
 }
 
@@ -407,6 +556,10 @@ void suite_scene(void)
     RUN_TEST(test_scene_minimal_defaults);
     RUN_TEST(test_scene_all_shapes_and_transform);
     RUN_TEST(test_scene_bad_syntax);
+    RUN_TEST(test_scene_raw_json);
+    RUN_TEST(test_scene_duplicate_names);
+    RUN_TEST(test_scene_hosts_disjoint);
+    RUN_TEST(test_scene_triangles_counted_first);
     RUN_TEST(test_scene_unknown_keys);
     RUN_TEST(test_scene_wrong_types);
     RUN_TEST(test_scene_unknown_names);
