@@ -37,9 +37,10 @@
 
 /* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices
- * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/render.h) and their
- * accumulation after each batch (renderer_trace_rays). Index 0 (VBCL_COUNT_PRIMARY) is
- * reserved: the host counts primary rays itself. */
+ * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/render.h), their
+ * accumulation after each batch (renderer_trace_rays) and their place in --stats-json: the
+ * object `group`, the key `key` (host/stats.c; docs/stats.md). Index 0 (VBCL_COUNT_PRIMARY)
+ * is reserved: the host counts primary rays itself. */
 /* clang-format off */
 #define VBCL_COUNTER_LIST(X)                                                                       \
     X(SHADOW,          1,  rays_shadow,     rays,     "shadow")           /* feelers traced */     \
