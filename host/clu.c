@@ -5,6 +5,7 @@
 #include "clu.h"
 
 #include "cache.h"
+#include "fileio.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -291,14 +292,8 @@ static void cache_store(cl_program prog, const char *path)
     if (!bin) return;
     unsigned char *bins[1] = {bin};
     if (clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins, NULL) == CL_SUCCESS) {
-        char tmp[4200];
-        snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-        FILE *f = fopen(tmp, "wb");
-        if (f) {
-            int ok = fwrite(bin, 1, size, f) == size;
-            ok &= fclose(f) == 0;
-            if (!ok || rename(tmp, path) != 0) remove(tmp);
-        }
+        char err[256]; /* a cache that cannot be written is only slower next time */
+        file_write_whole(path, bin, size, err, sizeof err);
     }
     free(bin);
 }

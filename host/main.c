@@ -15,8 +15,10 @@
 #include "diag.h"
 #include "kernel_features.h"
 #include "image_io.h"
+#include "fileio.h"
 #include "render.h"
 #include "scene.h"
+#include "stats.h"
 #include "texgen.h"
 
 #define VBCL_VERSION "0.1.0"
@@ -56,6 +58,8 @@ static const char usage_text[] =
     "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
+    "      --stats-json FILE    write the same statistics as JSON (fields: docs/stats.md);\n"
+    "                           an animation's frames go into one array, \"frames\"\n"
     "  -q, --quiet              print nothing but errors\n"
     "  -h, --help               show this help\n"
     "      --version            show the version\n"
@@ -67,7 +71,7 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid, *fresnel, *aa_map;
+    const char *scene, *output, *device, *grid, *fresnel, *aa_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
     double grid_density, exposure, min_weight, aa;
@@ -210,6 +214,9 @@ static int parse_args(int argc, char **argv, Options *o)
             o->list_devices = 1;
         } else if (!strcmp(a, "--stats")) {
             o->stats = 1;
+        } else if (!strcmp(a, "--stats-json")) {
+            NEEDS_VALUE;
+            o->stats_json = val;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
         } else if (a[0] == '-' && a[1]) {
@@ -271,93 +278,6 @@ static char *output_path(const Options *o, const Scene *s, int frame)
     return out;
 }
 
-static void print_stats(const Scene *s, const VbDevice *d, const Renderer *r, const RenderStats *st,
-                        double write_ms, double total_ms)
-{
-    char feat[128];
-    features_describe(st->features, feat, sizeof feat);
-    unsigned long long rays =
-        st->rays_primary + st->rays_refine + st->rays_shadow + st->reflected + st->transmitted;
-    double kernel_ms =
-        st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms + st->dispersion_ms;
-    unsigned strata = r->frame_host.shadow_strata;
-    fprintf(stderr, "scene       %s: %d objects, %u triangles, %d materials, %d lights\n", s->path,
-            s->nobjects, s->mesh.ntris, s->nmaterials, s->nlights);
-    fprintf(stderr, "device      %s (%s)\n", d->name, d->version);
-    fprintf(stderr, "features    %s\n", feat);
-    fprintf(stderr, "program     %.1f ms (%s), options: %s\n", st->build_ms,
-            st->build_cached ? "warm: cached binary" : "cold: built from source", st->options);
-    fprintf(
-        stderr,
-        "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max %u, "
-        "empty %.1f%%, per non-empty cell %.2f, refined %d times\n",
-        r->grid.n[0], r->grid.n[1], r->grid.n[2], r->grid.ncells, s->grid_res[0] ? "given" : "auto",
-        st->grid_ms, r->grid.tris_per_cell_mean, r->grid.tris_per_cell_max,
-        100.0 * r->grid.empty_fraction, r->grid.tris_per_nonempty_mean, r->grid.refinements);
-    fprintf(stderr,
-            "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point; %llu "
-            "skipped: light behind the surface), total %llu\n",
-            st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata, st->shadow_skipped,
-            rays);
-    if (st->features & VBCL_FEATURE_TRANSPARENCY) {
-        fprintf(
-            stderr,
-            "ray tree    reflected %llu, transmitted %llu, total internal reflections %llu; not "
-            "traced: %llu pruned (weight < %g), %llu deeper than max depth %d\n",
-            st->reflected, st->transmitted, st->tir, st->pruned, (double)s->min_weight,
-            st->depth_cut, s->max_depth);
-        fprintf(stderr, "energy      %llu interfaces split, %llu with |R + T - 1| > 1e-5\n",
-                st->interfaces, st->energy_errors);
-        if (st->features & VBCL_FEATURE_DISPERSION)
-            fprintf(stderr,
-                    "dispersion  %llu rays split into %d bands%s, %llu band rays traced, %.1f ms "
-                    "in dispersive subtrees (device)\n",
-                    st->splits, s->bands,
-                    s->band_layout == DISP_LAYOUT_THESIS ? " (thesis: 1 red, 2 green, 3 blue)" : "",
-                    st->band_rays, st->dispersion_ms);
-        fprintf(stderr, "by depth   ");
-        for (int k = 0; k < VBCL_COUNT_DEPTH_BINS; k++)
-            if (st->by_depth[k])
-                fprintf(stderr, " %s%d: %llu", k == VBCL_COUNT_DEPTH_BINS - 1 ? ">=" : "", k,
-                        st->by_depth[k]);
-        fputc('\n', stderr);
-    }
-    if (st->features & (VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_TEXTURES))
-        fprintf(stderr, "media       %llu crossings passed through (no change of material)\n",
-                st->pass_through);
-    fprintf(stderr, "work        %.2f cells visited and %.2f triangles tested per ray\n",
-            rays ? (double)st->traversal_steps / (double)rays : 0.0,
-            rays ? (double)st->tri_tests / (double)rays : 0.0);
-    long npix = (long)s->width * s->height;
-    fprintf(stderr, "samples     %.2f per pixel (mean), %u (max), %.4f of uniform 16x16\n",
-            (double)st->samples / (double)npix, st->samples_max,
-            (double)st->samples / (256.0 * (double)npix));
-    if (s->ssaa > 1)
-        fprintf(stderr, "anti-alias  uniform %dx%d supersampling, box window\n", s->ssaa, s->ssaa);
-    else if (s->aa_threshold > 0.0f) {
-        fprintf(stderr,
-                "anti-alias  adaptive, threshold %g, max level %d, %d rounds; pixels refined to "
-                "level",
-                (double)s->aa_threshold, s->aa_max_level, st->aa_rounds);
-        for (int l = 1; l <= s->aa_max_level; l++)
-            fprintf(stderr, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
-                    l < s->aa_max_level ? "," : "\n");
-        fprintf(stderr,
-                "aa time     contrast %.1f ms, refine %.1f ms (sample generation and tracing, "
-                "included in the stages below), reconstruct %.1f ms (device)\n",
-                st->aa_contrast_ms, st->aa_refine_ms, st->aa_reconstruct_ms);
-    }
-    fprintf(
-        stderr,
-        "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f ms, "
-        "ray trees %.1f ms, dispersive subtrees %.1f ms, readback %.1f ms (device) | render %.1f "
-        "ms, write %.1f ms, total %.1f ms (wall)\n",
-        st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->tree_ms,
-        st->dispersion_ms, st->readback_ms, st->render_ms, write_ms, total_ms);
-    fprintf(stderr, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
-            kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
-}
-
 /* Writes each pixel's refinement level as a heat map (aa_level_colour). */
 static int write_aa_map(const char *path, const Scene *s, const int *levels, char *err,
                         size_t errlen)
@@ -409,9 +329,41 @@ static int apply_options(const Options *o, Scene *s)
     return 0;
 }
 
-/* Renders frame `frame` of the scene (-1: a scene that is not animated) on dev and writes
- * it; t0 is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, const char *text, int frame, VbDevice *dev, double t0)
+/* Reports a frame written to out: --stats on stderr; with --stats-json its object added to
+ * *json and the document written (again after each frame of an animation, so the file
+ * always holds the frames done); the summary line on stdout unless -q. Returns an exit
+ * status. */
+static int report_frame(const Options *o, const StatsFrame *fr, const char *out, cJSON **json)
+{
+    const Scene *s = fr->scene;
+    if (o->stats) stats_print(stderr, fr);
+    if (o->stats_json) {
+        char err[1024];
+        if (stats_json_add_frame(json, fr)) {
+            fprintf(stderr, "vbcl: out of memory for the statistics\n");
+            return 1;
+        }
+        if (stats_json_write(o->stats_json, *json, err, sizeof err)) {
+            fprintf(stderr, "vbcl: %s\n", err);
+            return 1;
+        }
+    }
+    if (!o->quiet) {
+        unsigned long long rays = stats_rays_total(fr->st);
+        double render_ms = fr->st->render_ms;
+        printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
+               out, s->width, s->height, fr->total_ms / 1000.0, s->mesh.ntris, rays,
+               render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, fr->dev->name);
+        fflush(stdout);
+    }
+    return 0;
+}
+
+/* Renders frame `frame` of the scene (-1: a scene that is not animated; text: the scene
+ * file, read once) on dev, writes it and reports it (report_frame; *json: the --stats-json
+ * document); t0 is when this frame's work began. Returns an exit status. */
+static int render_frame(const Options *o, const char *text, int frame, VbDevice *dev, double t0,
+                        cJSON **json)
 {
     char err[1024] = "";
     Scene s;
@@ -461,20 +413,8 @@ static int render_frame(const Options *o, const char *text, int frame, VbDevice 
         rc = 1;
         goto done_renderer;
     }
-    double write_ms = clu_now_ms() - tw, total_ms = clu_now_ms() - t0;
-    if (o->stats) {
-        if (frame >= 0) fprintf(stderr, "frame       %d of %d\n", frame, s.frames);
-        print_stats(&s, dev, &fr.r, &st, write_ms, total_ms);
-    }
-    if (!o->quiet) {
-        unsigned long long rays =
-            st.rays_primary + st.rays_refine + st.rays_shadow + st.reflected + st.transmitted;
-        printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
-               out, s.width, s.height, total_ms / 1000.0, s.mesh.ntris, rays,
-               st.render_ms > 0 ? (double)rays / (st.render_ms * 1e3) : 0.0, dev->name);
-        fflush(stdout);
-    }
-    rc = 0;
+    StatsFrame sf = {&s, dev, &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0};
+    rc = report_frame(o, &sf, out, json);
 done_renderer:
     frame_release(&fr);
 done_scene:
@@ -483,6 +423,18 @@ done_scene:
     free(map);
     scene_free(&s);
     return rc;
+}
+
+/* Checks that a file can be written at path before any work (its directory exists and is
+ * writable). Returns 0, or 2 after a message naming the path. */
+static int check_output_dir(const char *path)
+{
+    char err[1024];
+    if (file_check_dir(path, err, sizeof err)) {
+        diag_print("vbcl", "%s", err);
+        return 2;
+    }
+    return 0;
 }
 
 /* Checks that path can be written before any work: a format vbcl writes, in a directory
@@ -494,18 +446,7 @@ static int check_output(const char *path)
         diag_print("vbcl", "%s", err);
         return 2;
     }
-    const char *slash = strrchr(path, '/');
-    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
-    if (!dir) return 2;
-    int rc = 0;
-    if (access(dir, W_OK | X_OK)) {
-        int e = errno;
-        diag_print("vbcl", "%s: cannot write there: %s%s", path, strerror(e),
-                   e == ENOENT ? " (the directory does not exist)" : "");
-        rc = 2;
-    }
-    free(dir);
-    return rc;
+    return check_output_dir(path);
 }
 
 /* Every output of frames first..last (or of the still image, frame -1): the image and
@@ -569,6 +510,7 @@ static int check_scene(const Options *o, const char *text, int *first, int *last
         }
     }
     if (!rc) rc = check_outputs(o, &s, *first, *last);
+    if (!rc && o->stats_json) rc = check_output_dir(o->stats_json);
     scene_free(&s);
     if (!rc && animated) rc = check_frames(o, text, *first, *last);
     return rc;
@@ -601,10 +543,12 @@ int main(int argc, char **argv)
         if (rc) diag_print("vbcl", "%s", err);
         opened = !rc;
     }
+    cJSON *json = NULL; /* the --stats-json document */
     for (int f = first; !rc && f <= last; f++) {
-        rc = render_frame(&o, text, f, &dev, t0);
+        rc = render_frame(&o, text, f, &dev, t0, &json);
         t0 = clu_now_ms();
     }
+    cJSON_Delete(json);
     if (opened) clu_device_close(&dev);
     free(text);
     return rc;

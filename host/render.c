@@ -173,20 +173,9 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
     st->dispersion_ms += ms[3];
     if (trace_ms) *trace_ms += ms[0] + ms[1] + ms[2] + ms[3];
     st->rays_primary += (unsigned long long)n;
-    st->rays_shadow += counts[VBCL_COUNT_SHADOW];
-    st->shadow_skipped += counts[VBCL_COUNT_SHADOW_SKIPPED];
-    st->traversal_steps += counts[VBCL_COUNT_TRAVERSAL_STEPS];
-    st->tri_tests += counts[VBCL_COUNT_TRI_TESTS];
-    st->reflected += counts[VBCL_COUNT_REFLECTED];
-    st->transmitted += counts[VBCL_COUNT_TRANSMITTED];
-    st->pruned += counts[VBCL_COUNT_PRUNED];
-    st->depth_cut += counts[VBCL_COUNT_DEPTH_CUT];
-    st->tir += counts[VBCL_COUNT_TIR];
-    st->splits += counts[VBCL_COUNT_SPLITS];
-    st->band_rays += counts[VBCL_COUNT_BAND_RAYS];
-    st->pass_through += counts[VBCL_COUNT_PASS_THROUGH];
-    st->interfaces += counts[VBCL_COUNT_INTERFACES];
-    st->energy_errors += counts[VBCL_COUNT_ENERGY_ERRORS];
+#define RENDER_ADD_COUNTER(name, index, field, group, key) st->field += counts[VBCL_COUNT_##name];
+    VBCL_COUNTER_LIST(RENDER_ADD_COUNTER)
+#undef RENDER_ADD_COUNTER
     st->by_depth[0] += (unsigned long long)n;
     for (int k = 1; k < VBCL_COUNT_DEPTH_BINS; k++)
         st->by_depth[k] += counts[VBCL_COUNT_DEPTH0 + k];

@@ -12,12 +12,13 @@
 
 /* What a render did and how long each part took (--stats). */
 typedef struct RenderStats {
-    unsigned long long rays_primary, rays_shadow, shadow_skipped;
+    unsigned long long rays_primary;
     unsigned long long rays_refine; /* adaptive anti-aliasing samples beyond pass 0 */
-    unsigned long long traversal_steps, tri_tests;
-    unsigned long long reflected, transmitted, pruned, depth_cut, tir, pass_through;
-    unsigned long long interfaces, energy_errors;
-    unsigned long long splits, band_rays; /* dispersion: white rays split, band rays traced */
+    /* the kernels' work counters (VBCL_COUNTER_LIST in kernels/types.h): rays_shadow,
+     * shadow_skipped, traversal_steps, tri_tests, reflected, transmitted, ... */
+#define RENDER_STATS_COUNTER(name, index, field, group, key) unsigned long long field;
+    VBCL_COUNTER_LIST(RENDER_STATS_COUNTER)
+#undef RENDER_STATS_COUNTER
     unsigned long long by_depth[VBCL_COUNT_DEPTH_BINS]; /* [0]: primary rays */
     unsigned features;
     char options[512];

@@ -39,25 +39,34 @@
 /* VbObject.flags */
 #define VBCL_OBJECT_HOST 1u /* a closed volume whose inside the medium state tracks */
 
-/* Ray-kind counters kept by the kernels (one atomic add per work item, not per ray). */
-#define VBCL_COUNT_PRIMARY         0
-#define VBCL_COUNT_SHADOW          1
-#define VBCL_COUNT_SHADOW_SKIPPED  2 /* feelers not traced: light behind the surface */
-#define VBCL_COUNT_TRAVERSAL_STEPS 3
-#define VBCL_COUNT_TRI_TESTS       4
-#define VBCL_COUNT_REFLECTED       5 /* secondary rays traced, by kind */
-#define VBCL_COUNT_TRANSMITTED     6
-#define VBCL_COUNT_PRUNED          7  /* branches not traced: weight below min_weight */
-#define VBCL_COUNT_DEPTH_CUT       8  /* branches not traced: deeper than max_depth */
-#define VBCL_COUNT_TIR             9  /* total internal reflections */
-#define VBCL_COUNT_PASS_THROUGH    10 /* crossings that changed no material */
-#define VBCL_COUNT_INTERFACES      11 /* interfaces where the tree split energy */
-#define VBCL_COUNT_ENERGY_ERRORS   12 /* of those, |R + T - 1| > 1e-5 (should stay 0) */
-#define VBCL_COUNT_SPLITS          13 /* white rays split into bands at a dispersive refraction */
-#define VBCL_COUNT_BAND_RAYS       14 /* rays traced that carry one wavelength band */
-#define VBCL_COUNT_DEPTH0          16 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
-#define VBCL_COUNT_DEPTH_BINS      16
-#define VBCL_COUNTERS              32
+/* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
+ * X(NAME, index, RenderStats field, stats group, key), from which come the indices
+ * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/render.h), their
+ * accumulation after each batch (renderer_trace_rays) and their place in --stats-json: the
+ * object `group`, the key `key` (host/stats.c; docs/stats.md). Index 0 (VBCL_COUNT_PRIMARY)
+ * is reserved: the host counts primary rays itself. */
+/* clang-format off */
+#define VBCL_COUNTER_LIST(X)                                                                       \
+    X(SHADOW,          1,  rays_shadow,     rays,     "shadow")           /* feelers traced */     \
+    X(SHADOW_SKIPPED,  2,  shadow_skipped,  rays,     "shadow_skipped")   /* light behind */       \
+    X(TRAVERSAL_STEPS, 3,  traversal_steps, work,     "cells_visited")    /* grid cells */         \
+    X(TRI_TESTS,       4,  tri_tests,       work,     "triangles_tested") /* ray/triangle */       \
+    X(REFLECTED,       5,  reflected,       ray_tree, "reflected")        /* secondary rays */     \
+    X(TRANSMITTED,     6,  transmitted,     ray_tree, "transmitted")      /* secondary rays */     \
+    X(PRUNED,          7,  pruned,          ray_tree, "pruned")           /* w < min_weight */     \
+    X(DEPTH_CUT,       8,  depth_cut,       ray_tree, "depth_cut")        /* > max_depth */        \
+    X(TIR,             9,  tir,             ray_tree, "tir")              /* total int. refl. */   \
+    X(PASS_THROUGH,    10, pass_through,    ray_tree, "pass_through")     /* no material change */ \
+    X(INTERFACES,      11, interfaces,      ray_tree, "interfaces")       /* energy splits */      \
+    X(ENERGY_ERRORS,   12, energy_errors,   ray_tree, "energy_errors")    /* |R+T-1| > 1e-5 */     \
+    X(SPLITS,          13, splits,          ray_tree, "splits")           /* white -> bands */     \
+    X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */
+/* clang-format on */
+#define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
+enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
+#define VBCL_COUNT_DEPTH0     16 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH_BINS 16
+#define VBCL_COUNTERS         32
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {
@@ -298,6 +307,18 @@ VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 64, aapass_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 32, aapass_first);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, seg_offset) == 48, aapass_seg_offset);
+
+/* The counter list's indices: distinct (their bits' sum equals their union), clear of the
+ * reserved index 0 and below the by-depth counters. */
+#define VBCL_COUNTER_BIT_OR(name, index, field, group, key)  | (1u << (index))
+#define VBCL_COUNTER_BIT_SUM(name, index, field, group, key) +(1u << (index))
+VBCL_STATIC_ASSERT((0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_OR)) ==
+                       (0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_SUM)),
+                   counters_distinct);
+VBCL_STATIC_ASSERT(((0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_OR)) & 1u) == 0 &&
+                       (0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_OR)) < (1u << VBCL_COUNT_DEPTH0),
+                   counters_in_range);
+VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, counters_depth);
 
 /* The scene's buffers, the one list behind every place that names them: the arguments
  * every frame kernel and scene probe starts with, in this order (render.cl

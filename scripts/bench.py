@@ -15,7 +15,8 @@ usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build] [--vbcl ./vb
 
 Writes OUT/<part>.csv, OUT/<part>.md and, for parts 2 and 3, OUT/<part>.png; OUT/bench.md
 collects the markdown tables with the machine and device they were measured on. Times come
-from `vbcl --stats`: device times from OpenCL event profiling, wall times around the render.
+from `vbcl --stats-json` (docs/stats.md): device times from OpenCL event profiling, wall
+times around the render.
 --quick runs every part on tiny images (part of `make test`, so the benchmark cannot rot);
 its numbers only show that each part runs.
 """
@@ -32,7 +33,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_aa  # noqa: E402  (installs numpy and matplotlib if missing)
-from bench_aa import np, plt, read_exr  # noqa: E402
+from bench_aa import np, plt, read_exr, read_stats_json  # noqa: E402
 
 A4 = "scenes/thesis/a4_two_prisms.json"
 
@@ -70,40 +71,39 @@ GRID_SIZES_QUICK = ["5", "16", "auto"]
 BANDS = [1, 2, 4, 6, 8, 16, 32]
 BANDS_QUICK = [1, 4]
 
-STAT_PATTERNS = {
-    "build_ms": r"^program\s+([\d.]+) ms",
-    "camera_ms": r"camera ([\d.]+) ms",
-    "intersect_ms": r"intersect ([\d.]+) ms",
-    "shading_ms": r"shading\+shadows ([\d.]+) ms",
-    "tree_ms": r"ray trees ([\d.]+) ms",
-    "dispersion_ms": r"dispersive subtrees ([\d.]+) ms",
-    "render_ms": r"\| render ([\d.]+) ms",
-    "write_ms": r"write ([\d.]+) ms",
-    "total_ms": r"total ([\d.]+) ms \(wall\)",
-    "aa_contrast_ms": r"aa time\s+contrast ([\d.]+) ms",
-    "aa_refine_ms": r"refine ([\d.]+) ms \(",
-    "aa_reconstruct_ms": r"reconstruct ([\d.]+) ms",
-    "rays_primary": r"^rays\s+primary (\d+)",
-    "rays_refine": r"refinement (\d+)",
-    "rays_shadow": r"shadow (\d+) \(",
-    "rays_total": r"skipped: light behind the surface\), total (\d+)",
-    "reflected": r"^ray tree\s+reflected (\d+)",
-    "transmitted": r"transmitted (\d+),",
-    "band_rays": r"(\d+) band rays traced",
-    "spp": r"^samples\s+([\d.]+) per pixel",
-    "triangles": r"^scene .*: \d+ objects, (\d+) triangles",
-    "grid": r"^grid\s+(\d+x\d+x\d+)",
+# The numbers the parts use, from `vbcl --stats-json` (docs/stats.md): name -> JSON path.
+STAT_FIELDS = {
+    "build_ms": ("program", "build_ms"),
+    "camera_ms": ("time_ms", "camera"),
+    "intersect_ms": ("time_ms", "intersect"),
+    "shading_ms": ("time_ms", "shading"),
+    "tree_ms": ("time_ms", "ray_trees"),
+    "dispersion_ms": ("time_ms", "dispersive_subtrees"),
+    "render_ms": ("time_ms", "render"),
+    "write_ms": ("time_ms", "write"),
+    "total_ms": ("time_ms", "total"),
+    "aa_contrast_ms": ("aa", "contrast_ms"),
+    "aa_refine_ms": ("aa", "refine_ms"),
+    "aa_reconstruct_ms": ("aa", "reconstruct_ms"),
+    "rays_primary": ("rays", "primary"),
+    "rays_refine": ("rays", "refinement"),
+    "rays_shadow": ("rays", "shadow"),
+    "rays_total": ("rays", "total"),
+    "reflected": ("ray_tree", "reflected"),
+    "transmitted": ("ray_tree", "transmitted"),
+    "band_rays": ("ray_tree", "band_rays"),
+    "spp": ("samples", "per_pixel_mean"),
+    "triangles": ("scene", "triangles"),
 }
 
 
 def run_stats(vbcl, scene, opts, env=None):
-    """Runs vbcl with --stats; returns the numbers of its report (0 where absent)."""
-    cmd = [vbcl, scene, "-q", "--stats"] + opts
-    log = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stderr
-    st = {"cold": "cold:" in log}
-    for k, pat in STAT_PATTERNS.items():
-        m = re.search(pat, log, re.M)
-        st[k] = (m.group(1) if k == "grid" else float(m.group(1))) if m else 0.0
+    """Runs vbcl with --stats-json; returns the numbers of STAT_FIELDS, "cold" (the program
+    was built from source) and "grid" ("XxYxZ")."""
+    doc = read_stats_json(vbcl, scene, opts, env)
+    st = {k: float(doc[g][f]) for k, (g, f) in STAT_FIELDS.items()}
+    st["cold"] = not doc["program"]["cached"]
+    st["grid"] = "x".join(str(n) for n in doc["grid"]["resolution"])
     return st
 
 

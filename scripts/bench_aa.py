@@ -6,7 +6,7 @@ same scene (docs/architecture.md, "Measurements").
 usage: scripts/bench_aa.py [--quick] [--vbcl ./vbcl] [--out bench-out] [--repeats N]
 
 Writes OUT/aa_time_error.csv (one row per render) and OUT/aa_time_error.png (RMSE against
-render time, one panel per scene). Time is the render's wall time from --stats (pass 0,
+render time, one panel per scene). Time is the render's wall time from --stats-json (pass 0,
 refinement and read-back; not the program build). Error: RMSE over the RGB channels of the
 linear image clamped to [0, 1] (what a display shows), and PSNR = 20 log10(1 / RMSE).
 The reference is rendered with another render.seed, so that its shadow-feeler jitter is
@@ -88,13 +88,24 @@ def reseeded(scene):
     return path
 
 
+def read_stats_json(vbcl, scene, opts, env=None):
+    """Runs vbcl -q --stats-json on scene; returns the document (fields: docs/stats.md)."""
+    fd, path = tempfile.mkstemp(prefix="vbcl-stats-", suffix=".json")
+    os.close(fd)
+    try:
+        subprocess.run([vbcl, scene, "-q", "--stats-json", path] + opts, check=True,
+                       capture_output=True, text=True, env=env)
+        with open(path) as f:
+            return json.load(f)
+    finally:
+        os.remove(path)
+
+
 def render(vbcl, scene, size, extra, opts, out):
-    cmd = [vbcl, scene, "-q", "--stats", "--width", str(size), "--height", str(size), "-o", out]
-    cmd += extra + opts
-    log = subprocess.run(cmd, check=True, capture_output=True, text=True).stderr
-    ms = float(re.search(r"\| render ([\d.]+) ms", log).group(1))
-    spp = float(re.search(r"^samples\s+([\d.]+) per pixel", log, re.M).group(1))
-    return ms, spp
+    """Renders scene at size x size into out; returns (render wall ms, samples per pixel)."""
+    st = read_stats_json(vbcl, scene,
+                         ["--width", str(size), "--height", str(size), "-o", out] + extra + opts)
+    return st["time_ms"]["render"], st["samples"]["per_pixel_mean"]
 
 
 def main():

@@ -2,7 +2,8 @@
 # bench_grid.sh — render time against the auto-grid density (cells per triangle).
 # Renders each scene at several --grid-density values, interleaved and repeated so that
 # machine noise hits every value alike, keeps the fastest run of each, and writes
-# OUTDIR/grid_density.csv and OUTDIR/grid_density.md (times relative to the best).
+# OUTDIR/grid_density.csv and OUTDIR/grid_density.md (times relative to the best), from
+# vbcl --stats-json (docs/stats.md).
 # usage: scripts/bench_grid.sh [--quick] [OUTDIR]      (default OUTDIR: bench-out)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,18 +33,17 @@ for spec in $scenes; do
     ./vbcl "$scene" -q --width "$w" --height "$h" -o "$tmp/warm.png" # builds and caches the kernels
     for rep in $(seq "$repeats"); do
         for d in $densities; do
-            ./vbcl "$scene" -q --stats --width "$w" --height "$h" --grid-density "$d" \
-                -o "$tmp/img.png" 2> "$tmp/stats.txt"
-            awk -v scene="$scene" -v d="$d" '
-                /^scene/ { for (i = 1; i <= NF; i++) if ($i == "triangles,") tris = $(i - 1) }
-                /^grid/ { grid = $2; cells = $4; build = $8; sub(/ms,?/, "", build)
-                          for (i = 1; i <= NF; i++) if ($i == "mean") mean = $(i + 1) }
-                /^time/ { for (i = 1; i <= NF; i++) {
-                            if ($i == "intersect") { x = $(i + 1) }
-                            if ($i == "shading+shadows") { s = $(i + 1) } } }
-                /^throughput/ { mr = $2 }
-                END { printf "%s,%s,%s,%s,%s,%s,%s,%s,%s,%.1f,%s\n", scene, tris, d, grid, cells,
-                      build, mean, x, s, x + s, mr }' "$tmp/stats.txt" >> "$tmp/runs.csv"
+            ./vbcl "$scene" -q --stats-json "$tmp/stats.json" --width "$w" --height "$h" \
+                --grid-density "$d" -o "$tmp/img.png"
+            python3 - "$tmp/stats.json" "$scene" "$d" >> "$tmp/runs.csv" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))  # fields: docs/stats.md
+g, t = s["grid"], s["time_ms"]
+print(f"{sys.argv[2]},{s['scene']['triangles']},{sys.argv[3]},"
+      f"{'x'.join(map(str, g['resolution']))},{g['cells']},{g['build_ms']:.1f},"
+      f"{g['tris_per_cell_mean']:.2f},{t['intersect']:.1f},{t['shading']:.1f},"
+      f"{t['intersect'] + t['shading']:.1f},{s['mrays_per_s']:.2f}")
+PY
         done
     done
 done

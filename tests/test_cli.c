@@ -1,11 +1,15 @@
 /* test_cli.c — the vbcl binary as a user meets it: help, devices, options, and bad input
  * of every class giving exit 2, a one-line message, and no output file touched. */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <cJSON.h>
 
 #include "harness.h"
 #include "image_io.h"
@@ -36,12 +40,46 @@ static int vbcl(const char *args, char *out, size_t n)
     return tu_run(cmd, out, n);
 }
 
+/* The file at path parsed as JSON, or NULL. */
+static cJSON *read_json(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char text[1 << 16];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = 0;
+    return cJSON_Parse(text);
+}
+
+/* The number at a path of object keys (NULL-terminated), or NAN where one is missing. */
+static double json_num(const cJSON *o, ...)
+{
+    va_list ap;
+    va_start(ap, o);
+    for (const char *k = va_arg(ap, const char *); k && o; k = va_arg(ap, const char *))
+        o = cJSON_GetObjectItemCaseSensitive(o, k);
+    va_end(ap);
+    return cJSON_IsNumber(o) ? o->valuedouble : NAN;
+}
+
+/* Whether dir holds a file whose name contains part. */
+static int dir_has(const char *dir, const char *part)
+{
+    DIR *d = opendir(dir);
+    int found = 0;
+    for (struct dirent *e; d && (e = readdir(d));) found |= strstr(e->d_name, part) != NULL;
+    if (d) closedir(d);
+    return found;
+}
+
 static void test_cli_help_and_usage(void)
 {
     char out[8192];
     CHECK(vbcl("--help", out, sizeof out) == 0, "--help exits 0");
     CHECK(strstr(out, "usage: vbcl SCENE.json") && strstr(out, "--grid") &&
-              strstr(out, "--list-devices") && strstr(out, "--stats"),
+              strstr(out, "--list-devices") && strstr(out, "--stats") &&
+              strstr(out, "--stats-json FILE"),
           "--help lists the options: %s", out);
     CHECK(vbcl("", out, sizeof out) == 2, "no scene: exit 2");
     CHECK(vbcl("--frobnicate x.json", out, sizeof out) == 2 && strstr(out, "--frobnicate"),
@@ -164,9 +202,21 @@ static void test_cli_frames(void)
         "   \"keys\": [[0, [0, 0, 0]], [2, [0.5, 0.5, 0.5]]]}]}}");
     char out[8192], args[2048], pattern[512], path[512];
     snprintf(pattern, sizeof pattern, "%s/frame_###.exr", tu_tmpdir());
-    snprintf(args, sizeof args, "%s -o %s --frames 1:2", scene, pattern);
+    char json[512];
+    snprintf(json, sizeof json, "%s/anim_stats.json", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s --frames 1:2 --stats-json %s", scene, pattern, json);
     int rc = vbcl(args, out, sizeof out);
     CHECK(rc == 0, "--frames 1:2 exits 0 (%d): %s", rc, out);
+    /* --stats-json: one document, an object per frame rendered */
+    cJSON *doc = read_json(json);
+    const cJSON *frames = cJSON_GetObjectItemCaseSensitive(doc, "frames");
+    CHECK(cJSON_GetArraySize(frames) == 2 && json_num(doc, "frames_in_scene", NULL) == 3,
+          "--stats-json of frames 1:2 has two frames of 3");
+    for (int k = 0; k < cJSON_GetArraySize(frames); k++)
+        CHECK(json_num(cJSON_GetArrayItem(frames, k), "frame", NULL) == 1 + k &&
+                  json_num(cJSON_GetArrayItem(frames, k), "rays", "primary", NULL) == 64,
+              "frames[%d] is frame %d with 64 primary rays", k, 1 + k);
+    cJSON_Delete(doc);
     for (int f = 0; f < 3; f++) {
         snprintf(path, sizeof path, "%s/frame_%03d.exr", tu_tmpdir(), f);
         CHECK(file_exists(path) == (f >= 1), "frame %d %s", f, f >= 1 ? "missing" : "written");
@@ -416,6 +466,86 @@ static void test_cli_messages_escaped(void)
                "camera.z\\x1b[2J");
 }
 
+/* --stats-json holds the numbers --stats prints; a path it cannot write fails the run
+ * before rendering (missing directory) or after it (exit 1), leaving no file either way. */
+static void test_cli_stats_json(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file("stats.json", GOOD_SCENE);
+    char out[16384], args[2048], json[512], img[512];
+    snprintf(json, sizeof json, "%s/stats-out.json", tu_tmpdir());
+    snprintf(img, sizeof img, "%s/stats.png", tu_tmpdir());
+    remove(json);
+    snprintf(args, sizeof args, "%s -o %s --aa 0.05 --stats --stats-json %s", scene, img, json);
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 0, "render with --stats --stats-json exits 0 (%d): %s", rc, out);
+    unsigned long long primary = 0, refine = 0, shadow = 0, total = 0;
+    unsigned tris = 0, cells = 0, spp_max = 0;
+    double spp = 0;
+    const char *l;
+    int got = 0;
+    if ((l = strstr(out, "\nrays        primary ")))
+        got += sscanf(l, "\nrays primary %llu, refinement %llu, shadow %llu", &primary, &refine,
+                      &shadow) == 3;
+    if ((l = strstr(out, "skipped: light behind the surface), total ")))
+        got += sscanf(l, "skipped: light behind the surface), total %llu", &total) == 1;
+    if ((l = strstr(out, " objects, "))) got += sscanf(l, " objects, %u triangles", &tris) == 1;
+    if ((l = strstr(out, " cells ("))) {
+        while (l > out && l[-1] != ' ') l--;
+        got += sscanf(l, "%u", &cells) == 1;
+    }
+    if ((l = strstr(out, "\nsamples     ")))
+        got += sscanf(l, "\nsamples %lf per pixel (mean), %u (max)", &spp, &spp_max) == 2;
+    CHECK(got == 5, "the --stats text has every number (%d of 5): %s", got, out);
+    CHECK(refine > 0 && spp > 1, "--aa 0.05 refines pixels (%llu, %g per pixel)", refine, spp);
+    cJSON *doc = read_json(json);
+    CHECK(doc != NULL, "%s parses as JSON", json);
+    CHECK(json_num(doc, "rays", "total", NULL) == (double)total, "rays.total %g, text %llu",
+          json_num(doc, "rays", "total", NULL), total);
+    CHECK(json_num(doc, "rays", "primary", NULL) == (double)primary, "rays.primary %g, text %llu",
+          json_num(doc, "rays", "primary", NULL), primary);
+    CHECK(json_num(doc, "rays", "refinement", NULL) == (double)refine,
+          "rays.refinement %g, text %llu", json_num(doc, "rays", "refinement", NULL), refine);
+    CHECK(json_num(doc, "rays", "shadow", NULL) == (double)shadow, "rays.shadow %g, text %llu",
+          json_num(doc, "rays", "shadow", NULL), shadow);
+    CHECK(json_num(doc, "scene", "triangles", NULL) == tris, "scene.triangles %g, text %u",
+          json_num(doc, "scene", "triangles", NULL), tris);
+    CHECK(json_num(doc, "grid", "cells", NULL) == cells, "grid.cells %g, text %u",
+          json_num(doc, "grid", "cells", NULL), cells);
+    double mean = json_num(doc, "samples", "per_pixel_mean", NULL);
+    CHECK(fabs(mean - spp) <= 0.005, "samples.per_pixel_mean %g, text %.2f", mean, spp);
+    CHECK(json_num(doc, "samples", "per_pixel_max", NULL) == spp_max,
+          "samples.per_pixel_max %g, text %u", json_num(doc, "samples", "per_pixel_max", NULL),
+          spp_max);
+    cJSON_Delete(doc);
+    /* -q and no --stats: nothing printed, the file still written */
+    remove(json);
+    snprintf(args, sizeof args, "%s -q -o %s --stats-json %s", scene, img, json);
+    rc = vbcl(args, out, sizeof out);
+    doc = read_json(json);
+    CHECK(rc == 0 && out[0] == 0 && json_num(doc, "rays", "primary", NULL) == 24 * 16,
+          "-q --stats-json writes the file alone (%d): %s", rc, out);
+    cJSON_Delete(doc);
+    /* a missing directory: exit 2 before rendering, neither file written */
+    remove(img);
+    snprintf(json, sizeof json, "%s/no-such-dir/stats.json", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s --stats-json %s", scene, img, json);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "no-such-dir"), "missing directory: exit 2 (%d): %s", rc, out);
+    CHECK(!file_exists(json) && !file_exists(img), "nothing written for a missing directory");
+    /* a path that cannot be renamed onto (a directory): exit 1, no temporary file left */
+    char dir[512];
+    snprintf(dir, sizeof dir, "%s/statsdir", tu_tmpdir());
+    mkdir(dir, 0755);
+    snprintf(args, sizeof args, "%s -q -o %s --stats-json %s", scene, img, dir);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "statsdir"), "unwritable path: exit 1 (%d): %s", rc, out);
+    CHECK(!dir_has(tu_tmpdir(), ".statsdir.tmp"), "no temporary file left beside it");
+}
+
 void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
@@ -429,4 +559,5 @@ void suite_cli(void)
     RUN_TEST(test_cli_mesh_files_capped);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
+    RUN_TEST(test_cli_stats_json);
 }
