@@ -21,14 +21,18 @@ ifeq ($(filter $(NO_CONFIG_GOALS),$(MAKECMDGOALS)),)
 -include build/config.mk
 endif
 
-CPPFLAGS := -Ihost -Ikernels $(PKG_CFLAGS) -MMD -MP
+# The host's folders (docs/architecture.md, "The host's layers"): each on the include path,
+# so a header is named by its file name wherever it lives.
+HOST_DIRS := host $(sort $(dir $(wildcard host/*/*.c host/*/*.h host/*/*.cpp)))
+HOST_INC  := $(patsubst %,-I%,$(patsubst %/,%,$(HOST_DIRS)))
+CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) -MMD -MP
 CFLAGS   := $(CSTD) $(OPT) $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -Wshadow $(SANFLAGS)
 LDFLAGS  := $(SANFLAGS)
 LDLIBS   := $(PKG_LIBS) -lm
 
-HOST_C   := $(wildcard host/*.c)
-HOST_CXX := $(wildcard host/*.cpp)
+HOST_C   := $(wildcard host/*.c host/*/*.c)
+HOST_CXX := $(wildcard host/*.cpp host/*/*.cpp)
 LIB_OBJ  := $(patsubst host/%.c,$(BUILD)/host/%.o,$(filter-out host/main.c,$(HOST_C))) \
             $(patsubst host/%.cpp,$(BUILD)/host/%.o,$(HOST_CXX)) $(BUILD)/kernel_source.o
 MAIN_OBJ := $(BUILD)/host/main.o
@@ -151,13 +155,14 @@ FUZZ_SECONDS ?= 60
 FUZZ_RUNS    ?=
 FUZZ_CC      ?= clang
 FUZZ_TARGETS := scene mesh_obj mesh_ply
-FUZZ_SRC     := host/scene.c host/diag.c host/mesh.c host/mesh_meet.c host/mesh_io.c host/shapes.c \
-                host/grid.c host/cache.c host/dispersion.c
+FUZZ_SRC     := host/scene/scene.c host/util/diag.c host/geom/mesh.c host/geom/mesh_meet.c \
+                host/geom/mesh_io.c host/geom/shapes.c host/accel/grid.c host/device/cache.c \
+                host/scene/dispersion.c
 build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk
 	@mkdir -p $(dir $@)
 	@echo "  FUZZ    $@"
 	$(Q)$(FUZZ_CC) $(CSTD) -g -O1 $(WARN) -Wno-unknown-warning-option \
-	    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -Ihost -Ikernels \
+	    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(HOST_INC) -Ikernels \
 	    $$(pkg-config --cflags libcjson) -o $@ $< $(FUZZ_SRC) $$(pkg-config --libs libcjson) -lm
 
 fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
@@ -179,7 +184,7 @@ fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
 	        echo "fuzz: $$t reached only $$execs of $(FUZZ_RUNS) executions in $(FUZZ_SECONDS) s"; exit 1; fi; \
 	done
 
-FORMAT_FILES := $(wildcard host/*.c host/*.h host/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \
+FORMAT_FILES := $(wildcard host/*.c host/*.h host/*/*.c host/*/*.h host/*/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \
                 tests/stress/*.c tests/fuzz/*.c tests/fuzz/*.h scripts/*.c)
 format:
 	clang-format -i $(FORMAT_FILES)

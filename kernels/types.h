@@ -8,7 +8,7 @@
 #include "solidtex.h"
 
 /* Feature bits: which code a scene needs. The host turns them into -D options
- * (features_build_options in host/kernel_features.c); kernels test the macros. */
+ * (features_build_options in host/device/kernel_features.c); kernels test the macros. */
 #define VBCL_FEATURE_AREA_LIGHTS    (1u << 0) /* some light has a radius > 0 */
 #define VBCL_FEATURE_SMOOTH_NORMALS (1u << 1) /* some triangle has vertex normals */
 #define VBCL_FEATURE_SPECULAR       (1u << 2) /* some material has a specular colour */
@@ -41,7 +41,7 @@
 
 /* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices
- * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/render.h), their
+ * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/device/render.h), their
  * accumulation after each batch (renderer_trace_rays) and their place in --stats-json: the
  * object `group`, the key `key` (host/stats.c; docs/stats.md). Index 0 (VBCL_COUNT_PRIMARY)
  * is reserved: the host counts primary rays itself. */
@@ -323,7 +323,7 @@ VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, c
 /* The scene's buffers, the one list behind every place that names them: the arguments
  * every frame kernel and scene probe starts with, in this order (render.cl
  * SCENE_KERNEL_ARGS), the device functions' DevScene (scene.cl), and the host's cl_mem
- * fields and clSetKernelArg calls (host/render.h, render.c). Each entry is
+ * fields and clSetKernelArg calls (host/device/render.h, render.c). Each entry is
  * X(address space, element type, kernel argument name, Renderer field). */
 #define VBCL_SCENE_BUFFERS(X)                                                                      \
     X(__constant, VbFrame, f, frame)                                                               \

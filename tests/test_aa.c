@@ -1,4 +1,4 @@
-/* test_aa.c — anti-aliasing through the vbcl binary (host/aa.c, kernels/aa.cl) on a scene of
+/* test_aa.c — anti-aliasing through the vbcl binary (host/frame/aa.c, kernels/aa.cl) on a scene of
  * hard edges and flat colours (tests/scenes/aa_edges.json, 64x64): the error against
  * uniform 16x16 supersampling falls with the threshold, flat regions are never refined,
  * the samples stay well below uniform 16x16, and refining a pixel changes no other pixel. */

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../host/grid.h"
+#include "grid.h"
 #include "harness.h"
 
 void suite_grid_build(void);

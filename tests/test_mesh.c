@@ -1,7 +1,7 @@
 /* test_mesh.c — tests of the mesh module: shapes, the closed-surface check, transforms and
  * the OBJ and PLY loaders (including their error messages). */
 #include "harness.h"
-#include "../host/mesh.h"
+#include "mesh.h"
 
 #include <dirent.h>
 #include <stdlib.h>

@@ -29,7 +29,7 @@ typedef struct RenderStats {
     double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
     double render_ms;     /* wall time of the tile loop */
     int tiles, tile_pixels;
-    /* anti-aliasing (--aa: adaptive, --ssaa: uniform; host/aa.c) */
+    /* anti-aliasing (--aa: adaptive, --ssaa: uniform; host/frame/aa.c) */
     int aa_rounds;                                          /* contrast passes that marked pixels */
     unsigned long long aa_refined[VBCL_AA_MAX_LEVEL + 1];   /* [L]: pixels refined to level L */
     unsigned long long samples;                             /* camera rays through the film */
