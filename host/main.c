@@ -4,6 +4,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -120,7 +121,114 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
     return 0;
 }
 
-/* Returns -1 to go on, or an exit status. */
+/* The options that only store their value (or set a flag), with their ranges. */
+enum { OPT_STRING, OPT_INT, OPT_DOUBLE, OPT_FLAG };
+typedef struct OptionSpec {
+    const char *name, *alias;
+    int kind;
+    size_t field; /* offset in Options */
+    double lo, hi;
+} OptionSpec;
+
+static const OptionSpec option_specs[] = {
+    {"--output", "-o", OPT_STRING, offsetof(Options, output), 0, 0},
+    {"--width", NULL, OPT_INT, offsetof(Options, width), 1, SCENE_MAX_IMAGE},
+    {"--height", NULL, OPT_INT, offsetof(Options, height), 1, SCENE_MAX_IMAGE},
+    {"--grid", NULL, OPT_STRING, offsetof(Options, grid), 0, 0},
+    {"--grid-density", NULL, OPT_DOUBLE, offsetof(Options, grid_density), 0.01, 64},
+    {"--shadow-samples", NULL, OPT_INT, offsetof(Options, shadow_samples), 1, 1024},
+    {"--depth", NULL, OPT_INT, offsetof(Options, depth), 1, 64},
+    {"--min-weight", NULL, OPT_DOUBLE, offsetof(Options, min_weight), 0, 1},
+    {"--aa", NULL, OPT_DOUBLE, offsetof(Options, aa), 0, 1},
+    {"--aa-max-level", NULL, OPT_INT, offsetof(Options, aa_max_level), 1, VBCL_AA_MAX_LEVEL},
+    {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
+    {"--aa-map", NULL, OPT_STRING, offsetof(Options, aa_map), 0, 0},
+    {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
+    {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
+    {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
+    {"--stats", NULL, OPT_FLAG, offsetof(Options, stats), 0, 0},
+    {"--quiet", "-q", OPT_FLAG, offsetof(Options, quiet), 0, 0},
+};
+
+static const OptionSpec *option_find(const char *a)
+{
+    for (size_t k = 0; k < sizeof option_specs / sizeof option_specs[0]; k++)
+        if (!strcmp(a, option_specs[k].name) ||
+            (option_specs[k].alias && !strcmp(a, option_specs[k].alias)))
+            return &option_specs[k];
+    return NULL;
+}
+
+/* Stores option a's value val (NULL: none left) as spec says. Returns -1 (go on) or an
+ * exit status after a usage error. */
+static int option_store(Options *o, const OptionSpec *spec, const char *a, const char *val)
+{
+    char *field = (char *)o + spec->field;
+    switch (spec->kind) {
+    case OPT_FLAG:
+        *(int *)field = 1;
+        return -1;
+    case OPT_STRING:
+        *(const char **)field = val;
+        return -1;
+    case OPT_INT:
+        return parse_int(a, val, (int)spec->lo, (int)spec->hi, (int *)field) ? 2 : -1;
+    default:
+        return parse_double(a, val, spec->lo, spec->hi, (double *)field) ? 2 : -1;
+    }
+}
+
+/* --frames A:B or N. Returns -1 or 2. */
+static int option_frames(Options *o, const char *val)
+{
+    char *end;
+    errno = 0;
+    long f0 = strtol(val, &end, 10), f1 = f0;
+    if (end != val && *end == ':') {
+        const char *b = end + 1;
+        f1 = strtol(b, &end, 10);
+        if (end == b) f1 = -1;
+    }
+    if (end == val || *end || errno || f0 < 0 || f1 < f0 || f1 > 100000)
+        return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", diag_value(val));
+    o->frame_first = (int)f0;
+    o->frame_last = (int)f1;
+    return -1;
+}
+
+/* The options with a value that need more than a range: --frames, --fresnel, --exposure,
+ * --bands. Returns -1 (stored), 2 (usage error) or -2 (a is none of them). */
+static int option_special(Options *o, const char *a, const char *val)
+{
+    if (!strcmp(a, "--frames")) return option_frames(o, val);
+    if (!strcmp(a, "--fresnel")) {
+        if (strcmp(val, "exact") && strcmp(val, "thesis"))
+            return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
+        o->fresnel = val;
+        return -1;
+    }
+    if (!strcmp(a, "--exposure")) {
+        o->have_exposure = 1;
+        return parse_double(a, val, -30, 30, &o->exposure) ? 2 : -1;
+    }
+    if (!strcmp(a, "--bands")) {
+        if (!strcmp(val, "thesis")) {
+            o->bands = 0; /* the thesis layout */
+            return -1;
+        }
+        return parse_int(a, val, 1, DISP_MAX_BANDS, &o->bands) ? 2 : -1;
+    }
+    return -2;
+}
+
+static int is_special_option(const char *a)
+{
+    return !strcmp(a, "--frames") || !strcmp(a, "--fresnel") || !strcmp(a, "--exposure") ||
+           !strcmp(a, "--bands");
+}
+
+/* Reads the command line into o. Returns -1 to go on and render, or an exit status (0
+ * after --help or --version, 2 after a usage error). */
 static int parse_args(int argc, char **argv, Options *o)
 {
     memset(o, 0, sizeof *o);
@@ -131,94 +239,22 @@ static int parse_args(int argc, char **argv, Options *o)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
-#define NEEDS_VALUE                                                                                \
-    do {                                                                                           \
-        if (!val) return usage_error("%s needs a value", diag_value(a));                           \
-        i++;                                                                                       \
-    } while (0)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage_text, stdout);
             return 0;
-        } else if (!strcmp(a, "--version")) {
+        }
+        if (!strcmp(a, "--version")) {
             printf("vbcl %s\n", VBCL_VERSION);
             return 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            NEEDS_VALUE;
-            o->output = val;
-        } else if (!strcmp(a, "--frames")) {
-            NEEDS_VALUE;
-            char *end;
-            errno = 0;
-            long f0 = strtol(val, &end, 10), f1 = f0;
-            if (end != val && *end == ':') {
-                const char *b = end + 1;
-                f1 = strtol(b, &end, 10);
-                if (end == b) f1 = -1;
+        }
+        const OptionSpec *spec = option_find(a);
+        if (spec || is_special_option(a)) {
+            if (!(spec && spec->kind == OPT_FLAG)) {
+                if (!val) return usage_error("%s needs a value", diag_value(a));
+                i++;
             }
-            if (end == val || *end || errno || f0 < 0 || f1 < f0 || f1 > 100000)
-                return usage_error("--frames %s: expected A:B or N, 0 <= A <= B", diag_value(val));
-            o->frame_first = (int)f0;
-            o->frame_last = (int)f1;
-        } else if (!strcmp(a, "--width")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, SCENE_MAX_IMAGE, &o->width)) return 2;
-        } else if (!strcmp(a, "--height")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, SCENE_MAX_IMAGE, &o->height)) return 2;
-        } else if (!strcmp(a, "--grid")) {
-            NEEDS_VALUE;
-            o->grid = val;
-        } else if (!strcmp(a, "--grid-density")) {
-            NEEDS_VALUE;
-            if (parse_double(a, val, 0.01, 64, &o->grid_density)) return 2;
-        } else if (!strcmp(a, "--shadow-samples")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, 1024, &o->shadow_samples)) return 2;
-        } else if (!strcmp(a, "--depth")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, 64, &o->depth)) return 2;
-        } else if (!strcmp(a, "--min-weight")) {
-            NEEDS_VALUE;
-            if (parse_double(a, val, 0, 1, &o->min_weight)) return 2;
-        } else if (!strcmp(a, "--fresnel")) {
-            NEEDS_VALUE;
-            if (strcmp(val, "exact") && strcmp(val, "thesis"))
-                return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
-            o->fresnel = val;
-        } else if (!strcmp(a, "--exposure")) {
-            NEEDS_VALUE;
-            if (parse_double(a, val, -30, 30, &o->exposure)) return 2;
-            o->have_exposure = 1;
-        } else if (!strcmp(a, "--aa")) {
-            NEEDS_VALUE;
-            if (parse_double(a, val, 0, 1, &o->aa)) return 2;
-        } else if (!strcmp(a, "--aa-max-level")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, VBCL_AA_MAX_LEVEL, &o->aa_max_level)) return 2;
-        } else if (!strcmp(a, "--bands")) {
-            NEEDS_VALUE;
-            if (!strcmp(val, "thesis"))
-                o->bands = 0; /* the thesis layout */
-            else if (parse_int(a, val, 1, DISP_MAX_BANDS, &o->bands))
-                return 2;
-        } else if (!strcmp(a, "--ssaa")) {
-            NEEDS_VALUE;
-            if (parse_int(a, val, 1, 16, &o->ssaa)) return 2;
-        } else if (!strcmp(a, "--aa-map")) {
-            NEEDS_VALUE;
-            o->aa_map = val;
-        } else if (!strcmp(a, "--device")) {
-            NEEDS_VALUE;
-            o->device = val;
-        } else if (!strcmp(a, "--list-devices")) {
-            o->list_devices = 1;
-        } else if (!strcmp(a, "--stats")) {
-            o->stats = 1;
-        } else if (!strcmp(a, "--stats-json")) {
-            NEEDS_VALUE;
-            o->stats_json = val;
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            o->quiet = 1;
+            int rc = spec ? option_store(o, spec, a, val) : option_special(o, a, val);
+            if (rc >= 0) return rc;
         } else if (a[0] == '-' && a[1]) {
             return usage_error("unknown option %s", diag_value(a));
         } else if (o->scene) {
@@ -226,7 +262,6 @@ static int parse_args(int argc, char **argv, Options *o)
         } else {
             o->scene = a;
         }
-#undef NEEDS_VALUE
     }
     if (!o->scene && !o->list_devices) return usage_error("%s", "no scene file given");
     return -1;

@@ -329,15 +329,13 @@ int grid_build(Grid *g, const Mesh *m, const int res[3], float density, char *er
     return grid_build_tuned(g, m, res, density, GRID_AUTO_TARGET, GRID_AUTO_MAX_CELLS, err, errlen);
 }
 
-int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, float target,
-                     uint32_t max_cells, char *err, size_t errlen)
+/* The scene's bounds from every vertex (checked: in range, finite), and the grid's box
+ * around them. Returns the reference magnitude for the overlap tests, or -1 with a message
+ * in err. */
+static double grid_bounds(Grid *g, const Mesh *m, char *err, size_t errlen)
 {
-    double t0 = now_ms();
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    uint32_t ntris = m->ntris;
-    memset(g, 0, sizeof *g);
-
-    for (uint32_t t = 0; t < ntris; t++) {
+    for (uint32_t t = 0; t < m->ntris; t++) {
         for (int k = 0; k < 3; k++) {
             uint32_t vi = m->tris[3 * (size_t)t + k];
             if (vi >= m->nverts) {
@@ -358,7 +356,7 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
             }
         }
     }
-    if (ntris == 0)
+    if (m->ntris == 0)
         for (int i = 0; i < 3; i++) {
             blo[i] = -0.5;
             bhi[i] = 0.5;
@@ -370,44 +368,55 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
                        blo[i], bhi[i], i);
             return -1;
         }
+    return ref;
+}
 
-    int use_auto = res == NULL || res[0] <= 0 || res[1] <= 0 || res[2] <= 0;
-    if (use_auto) {
+/* The first resolution: `auto` from the density, or the one given (checked against the
+ * cell limit). Returns 0, or -1 with a message in err. */
+static int grid_first_resolution(Grid *g, const int res[3], uint32_t ntris, float density,
+                                 char *err, size_t errlen)
+{
+    if (res == NULL || res[0] <= 0 || res[1] <= 0 || res[2] <= 0) {
         if (!(density > 0.0f) || !isfinite(density)) density = GRID_DEFAULT_DENSITY;
         grid_auto_resolution(g->lo, g->hi, ntris, density, g->n);
-    } else {
-        uint64_t cells = 1;
-        for (int i = 0; i < 3 && cells <= GRID_MAX_CELLS; i++) cells *= (uint64_t)res[i];
-        if (cells > GRID_MAX_CELLS) {
-            grid_error(err, errlen, "resolution %dx%dx%d gives %.0f cells, more than the limit %u",
-                       res[0], res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
-            return -1;
-        }
-        for (int i = 0; i < 3; i++) g->n[i] = res[i];
+        return 0;
     }
+    uint64_t cells = 1;
+    for (int i = 0; i < 3 && cells <= GRID_MAX_CELLS; i++) cells *= (uint64_t)res[i];
+    if (cells > GRID_MAX_CELLS) {
+        grid_error(err, errlen, "resolution %dx%dx%d gives %.0f cells, more than the limit %u",
+                   res[0], res[1], res[2], (double)res[0] * res[1] * res[2], GRID_MAX_CELLS);
+        return -1;
+    }
+    for (int i = 0; i < 3; i++) g->n[i] = res[i];
+    return 0;
+}
 
-    /* Pass 1, once per resolution tried: count each cell's triangles into cell_start[cell].
-     * `auto` keeps raising the resolution while the non-empty cells are crowded. */
-    GridCtx x;
-    uint64_t total;
-    uint32_t nonempty;
+/* Pass 1, once per resolution tried: counts each cell's triangles into cell_start[cell];
+ * with `auto` (use_auto) it keeps raising the resolution while the non-empty cells are
+ * crowded. Leaves the context of the final resolution in x, the total of references in
+ * *total and the non-empty cells in *nonempty. Returns 0, or -1 (out of memory). */
+static int grid_count_pass(Grid *g, const Mesh *m, double ref, int use_auto, float target,
+                           uint32_t max_cells, GridCtx *x, uint64_t *total, uint32_t *nonempty,
+                           char *err, size_t errlen)
+{
+    uint32_t ntris = m->ntris;
     double prev_cells = 0.0, prev_mean = 0.0;
     double cap = fmin((double)max_cells, (double)GRID_MAX_CELLS);
     for (;;) {
-        grid_ctx_init(g, ref, &x);
+        grid_ctx_init(g, ref, x);
         g->cell_start = calloc((size_t)g->ncells + 1, sizeof *g->cell_start);
         if (!g->cell_start) {
             grid_error(err, errlen, "grid: out of memory for %u cells", g->ncells);
-            grid_free(g);
             return -1;
         }
-        total = grid_count(g, &x, m, g->cell_start, &nonempty);
+        *total = grid_count(g, x, m, g->cell_start, nonempty);
         if (!use_auto || !(target > 0.0f) || g->refinements >= GRID_AUTO_MAX_ROUNDS ||
-            nonempty == 0)
-            break;
-        double mean = (double)total / nonempty;
+            *nonempty == 0)
+            return 0;
+        double mean = (double)*total / *nonempty;
         double want = grid_auto_next(g->ncells, mean, prev_cells, prev_mean, target, cap);
-        if (want == 0.0) break;
+        if (want == 0.0) return 0;
         int n[3];
         grid_auto_resolution(g->lo, g->hi, ntris, (float)(want / fmax(ntris, 1.0)), n);
         while ((double)n[0] * n[1] * n[2] > cap) { /* rounding may overshoot the cap */
@@ -416,13 +425,55 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
                 if (n[i] > n[big]) big = i;
             n[big]--;
         }
-        if ((double)n[0] * n[1] * n[2] <= g->ncells) break;
+        if ((double)n[0] * n[1] * n[2] <= g->ncells) return 0;
         prev_cells = g->ncells;
         prev_mean = mean;
         memcpy(g->n, n, sizeof n);
         free(g->cell_start);
         g->cell_start = NULL;
         g->refinements++;
+    }
+}
+
+/* Pass 2: counts become start offsets; visiting every triangle advances each to its cell's
+ * end; shifting by one cell then gives the starts again, with cell_start[ncells] = nrefs.
+ * Returns the most triangles in one cell. */
+static uint32_t grid_fill_pass(Grid *g, const Mesh *m, const GridCtx *x)
+{
+    uint32_t sum = 0, maxc = 0;
+    for (uint32_t c = 0; c < g->ncells; c++) {
+        uint32_t k = g->cell_start[c];
+        maxc = k > maxc ? k : maxc;
+        g->cell_start[c] = sum;
+        sum += k;
+    }
+    g->cell_start[g->ncells] = sum;
+    uint64_t total = 0;
+    double tri[3][3];
+    for (uint32_t t = 0; t < m->ntris; t++) {
+        grid_triangle(m, t, tri);
+        grid_visit(g, x, tri, t, g->cell_start, g->cell_tris, &total);
+    }
+    memmove(g->cell_start + 1, g->cell_start, (size_t)g->ncells * sizeof *g->cell_start);
+    g->cell_start[0] = 0;
+    return maxc;
+}
+
+int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, float target,
+                     uint32_t max_cells, char *err, size_t errlen)
+{
+    double t0 = now_ms();
+    memset(g, 0, sizeof *g);
+    double ref = grid_bounds(g, m, err, errlen);
+    if (ref < 0 || grid_first_resolution(g, res, m->ntris, density, err, errlen)) return -1;
+    int use_auto = res == NULL || res[0] <= 0 || res[1] <= 0 || res[2] <= 0;
+    GridCtx x;
+    uint64_t total;
+    uint32_t nonempty;
+    if (grid_count_pass(g, m, ref, use_auto, target, max_cells, &x, &total, &nonempty, err,
+                        errlen)) {
+        grid_free(g);
+        return -1;
     }
     if (total > UINT32_MAX) {
         grid_error(err, errlen,
@@ -440,26 +491,7 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
         grid_free(g);
         return -1;
     }
-
-    /* Counts become start offsets; pass 2 advances each to its cell's end; shifting by one
-     * cell then gives the starts again, with cell_start[ncells] = nrefs. */
-    uint32_t sum = 0, maxc = 0;
-    for (uint32_t c = 0; c < g->ncells; c++) {
-        uint32_t k = g->cell_start[c];
-        maxc = k > maxc ? k : maxc;
-        g->cell_start[c] = sum;
-        sum += k;
-    }
-    g->cell_start[g->ncells] = sum;
-    total = 0;
-    double tri[3][3];
-    for (uint32_t t = 0; t < ntris; t++) {
-        grid_triangle(m, t, tri);
-        grid_visit(g, &x, tri, t, g->cell_start, g->cell_tris, &total);
-    }
-    memmove(g->cell_start + 1, g->cell_start, (size_t)g->ncells * sizeof *g->cell_start);
-    g->cell_start[0] = 0;
-
+    uint32_t maxc = grid_fill_pass(g, m, &x);
     g->tris_per_cell_mean = (float)((double)g->nrefs / g->ncells);
     g->tris_per_cell_max = maxc;
     g->nonempty = nonempty;
