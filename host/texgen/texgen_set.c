@@ -10,6 +10,8 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include "fileio.h"
+
 /* ---- random numbers ---- */
 
 static uint64_t splitmix64(uint64_t *x)
@@ -102,8 +104,9 @@ static int all_have_normals(const TexSet *t)
     return t->count > 0;
 }
 
-static void write_obj(FILE *f, const TexSet *t)
+static void write_obj(FILE *f, const void *ctx)
 {
+    const TexSet *t = ctx;
     int normals = all_have_normals(t);
     uint64_t base = 1;
     fprintf(f, "# vbcl texgen %s\n", t->params);
@@ -151,8 +154,9 @@ static void put_u32(FILE *f, uint32_t u)
     fwrite(b, 1, 4, f);
 }
 
-static void write_ply(FILE *f, const TexSet *t)
+static void write_ply(FILE *f, const void *ctx)
 {
+    const TexSet *t = ctx;
     int normals = all_have_normals(t);
     uint64_t nv = 0, nt = 0;
     for (int e = 0; e < t->count; e++) {
@@ -211,28 +215,7 @@ int texset_write(const TexSet *t, const char *path, char *err, size_t errlen)
         snprintf(err, errlen, "%s: unknown mesh extension (expected .obj or .ply)", path);
         return -2;
     }
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof tmp) {
-        snprintf(err, errlen, "%s: path too long", path);
-        return -1;
-    }
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
-        return -1;
-    }
-    if (obj)
-        write_obj(f, t);
-    else
-        write_ply(f, t);
-    int bad = ferror(f);
-    if (fclose(f) != 0) bad = 1;
-    if (bad || rename(tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno ? errno : EIO));
-        remove(tmp);
-        return -1;
-    }
-    return 0;
+    return file_write_stream(path, obj ? write_obj : write_ply, t, err, errlen);
 }
 
 int texset_check_disjoint(const TexSet *t, char *err, size_t errlen)

@@ -16,7 +16,8 @@ static int temp_name(const char *path, char *tmp, size_t n)
     return k < 0 || (size_t)k >= n ? -1 : 0;
 }
 
-int file_write_whole(const char *path, const void *data, size_t n, char *err, size_t errlen)
+int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
+                      char *err, size_t errlen)
 {
     char tmp[4200];
     if (temp_name(path, tmp, sizeof tmp)) {
@@ -28,7 +29,9 @@ int file_write_whole(const char *path, const void *data, size_t n, char *err, si
         snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
         return -1;
     }
-    int ok = fwrite(data, 1, n, f) == n;
+    errno = 0;
+    write(f, ctx);
+    int ok = !ferror(f);
     int saved = errno;
     if (fclose(f) != 0 && ok) {
         ok = 0;
@@ -44,6 +47,24 @@ int file_write_whole(const char *path, const void *data, size_t n, char *err, si
         return -1;
     }
     return 0;
+}
+
+/* The bytes of file_write_whole. */
+typedef struct Bytes {
+    const void *data;
+    size_t n;
+} Bytes;
+
+static void write_bytes(FILE *f, const void *ctx)
+{
+    const Bytes *b = ctx;
+    fwrite(b->data, 1, b->n, f);
+}
+
+int file_write_whole(const char *path, const void *data, size_t n, char *err, size_t errlen)
+{
+    Bytes b = {data, n};
+    return file_write_stream(path, write_bytes, &b, err, errlen);
 }
 
 int file_check_dir(const char *path, char *err, size_t errlen)
