@@ -267,123 +267,144 @@ static int obj_corner(const Ctx *c, long line, char **s, size_t npos, size_t nnr
     return 0;
 }
 
+/* OBJ parser state: what the lines read so far gave. */
+typedef struct ObjState {
+    const Ctx *c;
+    long line;
+    Vec3List pos, nrm;
+    CornerList corners; /* 3 per triangle */
+    size_t ntex;
+} ObjState;
+
+/* "v x y z [w | r g b [a]]" or "vn x y z"; s points past the keyword. */
+static int obj_vertex(ObjState *st, char *s, int is_v)
+{
+    const char *kw = is_v ? "v" : "vn";
+    float xyz[3], extra;
+    int r = 0, got = 0, nextra = 0;
+    while (got < 3 && (r = parse_float(&s, &xyz[got])) == 0) got++;
+    while (r == 0 && (r = parse_float(&s, &extra)) == 0) nextra++;
+    if (r == -2) return fail(st->c, ":%ld: non-finite number after '%s'", st->line, kw);
+    if (r != 1 || got < 3 || nextra > (is_v ? 4 : 0))
+        return fail(st->c, ":%ld: expected 3 numbers after '%s'", st->line, kw);
+    vec3 q = v3(xyz[0], xyz[1], xyz[2]);
+    if (vec3list_push(is_v ? &st->pos : &st->nrm, is_v ? q : v3_norm(q)) < 0)
+        return fail(st->c, ":%ld: too many vertices or out of memory", st->line);
+    return 0;
+}
+
+/* "f c1 c2 c3 ...": a polygon, kept as a fan of triangles (3 corners each). */
+static int obj_face(ObjState *st, char *s)
+{
+    Corner first = {0, 0}, prev = {0, 0}, cur;
+    size_t n = 0;
+    for (;;) {
+        s = skip_space(s);
+        if (*s == '\0') break;
+        if (obj_corner(st->c, st->line, &s, st->pos.n, st->nrm.n, st->ntex, &cur) < 0) return -1;
+        if (n == 0)
+            first = cur;
+        else if (n >= 2 && (cornerlist_push(&st->corners, first) < 0 ||
+                            cornerlist_push(&st->corners, prev) < 0 ||
+                            cornerlist_push(&st->corners, cur) < 0))
+            return fail(st->c, ":%ld: out of memory", st->line);
+        prev = cur;
+        n++;
+    }
+    if (n < 3) return fail(st->c, ":%ld: face with %zu vertices (need at least 3)", st->line, n);
+    return 0;
+}
+
+/* One NUL-terminated line, by its keyword. */
+static int obj_line(ObjState *st, char *s)
+{
+    char *kw = skip_space(s);
+    s = kw;
+    while (*s && !is_space(*s)) s++;
+    size_t kwlen = (size_t)(s - kw);
+    if (kwlen == 1 && kw[0] == 'v') return obj_vertex(st, s, 1);
+    if (kwlen == 2 && kw[0] == 'v' && kw[1] == 'n') return obj_vertex(st, s, 0);
+    if (kwlen == 2 && kw[0] == 'v' && kw[1] == 't') {
+        st->ntex++;
+        return 0;
+    }
+    if (kwlen == 1 && kw[0] == 'f') return obj_face(st, s);
+    /* everything else (vt, o, g, s, usemtl, mtllib, l, comments, ...) is ignored */
+    return 0;
+}
+
+/* Every corner has a normal: one mesh vertex per distinct (position, normal) pair.
+ * Returns -1 when out of memory. */
+static int obj_mesh_normals(const ObjState *st, Mesh *m)
+{
+    const CornerList *cl = &st->corners;
+    PairMap pm = {0};
+    uint32_t t[3];
+    size_t i;
+    if (mesh_enable_normals(m) < 0) return -1;
+    for (i = 0; i < cl->n; i++) {
+        Corner k = cl->c[i];
+        uint32_t v = m->nverts;
+        int r = pairmap_get(&pm, (uint64_t)k.pos << 32 | k.nrm, &v);
+        if (r < 0) break;
+        if (r == 0) {
+            if (mesh_add_vertex(m, st->pos.v[k.pos]) == UINT32_MAX) break;
+            m->normals[v] = st->nrm.v[k.nrm];
+        }
+        t[i % 3] = v;
+        if (i % 3 == 2 && mesh_add_triangle(m, t[0], t[1], t[2]) < 0) break;
+    }
+    free(pm.keys);
+    free(pm.vals);
+    return i == cl->n ? 0 : -1;
+}
+
+/* Builds the mesh from the corners: the positions as they are when any corner lacks a
+ * normal, else with normals. Returns -1 when out of memory. */
+static int obj_mesh(const ObjState *st, Mesh *m)
+{
+    const CornerList *cl = &st->corners;
+    int with_normals = 1;
+    for (size_t i = 0; i < cl->n && with_normals; i++) with_normals = cl->c[i].nrm != UINT32_MAX;
+    if (with_normals) return obj_mesh_normals(st, m);
+    for (size_t i = 0; i < st->pos.n; i++)
+        if (mesh_add_vertex(m, st->pos.v[i]) == UINT32_MAX) return -1;
+    for (size_t i = 0; i < cl->n; i += 3)
+        if (mesh_add_triangle(m, cl->c[i].pos, cl->c[i + 1].pos, cl->c[i + 2].pos) < 0) return -1;
+    return 0;
+}
+
 static int load_obj(const Ctx *c, char *data, size_t len, Mesh *out)
 {
-    Vec3List pos = {0}, nrm = {0};
-    CornerList corners = {0}; /* 3 per triangle */
-    PairMap pm = {0};
+    ObjState st = {.c = c};
     Mesh m;
-    size_t ntex = 0;
     int rc = -1;
-    long line = 0;
     char *p = data, *endp = data + len;
     mesh_init(&m);
     while (p < endp) {
-        line++;
+        st.line++;
         char *eol = memchr(p, '\n', (size_t)(endp - p));
         if (!eol) eol = endp;
         *eol = '\0';
-        char *s = skip_space(p), *kw = s;
+        char *s = p;
         p = eol + 1;
-        while (*s && !is_space(*s)) s++;
-        size_t kwlen = (size_t)(s - kw);
-        int is_v = kwlen == 1 && kw[0] == 'v', is_vn = kwlen == 2 && kw[0] == 'v' && kw[1] == 'n';
-        if (is_v || is_vn) {
-            /* v x y z [w | r g b [a]]; vn x y z */
-            float xyz[3], extra;
-            int r = 0, got = 0, nextra = 0;
-            while (got < 3 && (r = parse_float(&s, &xyz[got])) == 0) got++;
-            while (r == 0 && (r = parse_float(&s, &extra)) == 0) nextra++;
-            if (r == -2) {
-                fail(c, ":%ld: non-finite number after '%s'", line, is_v ? "v" : "vn");
-                goto done;
-            }
-            if (r != 1 || got < 3 || nextra > (is_v ? 4 : 0)) {
-                fail(c, ":%ld: expected 3 numbers after '%s'", line, is_v ? "v" : "vn");
-                goto done;
-            }
-            vec3 q = v3(xyz[0], xyz[1], xyz[2]);
-            if (vec3list_push(is_v ? &pos : &nrm, is_v ? q : v3_norm(q)) < 0) {
-                fail(c, ":%ld: too many vertices or out of memory", line);
-                goto done;
-            }
-        } else if (kwlen == 2 && kw[0] == 'v' && kw[1] == 't') {
-            ntex++;
-        } else if (kwlen == 1 && kw[0] == 'f') {
-            Corner first = {0, 0}, prev = {0, 0}, cur;
-            size_t n = 0;
-            for (;;) {
-                s = skip_space(s);
-                if (*s == '\0') break;
-                if (obj_corner(c, line, &s, pos.n, nrm.n, ntex, &cur) < 0) goto done;
-                if (n == 0)
-                    first = cur;
-                else if (n >= 2 && (cornerlist_push(&corners, first) < 0 ||
-                                    cornerlist_push(&corners, prev) < 0 ||
-                                    cornerlist_push(&corners, cur) < 0)) {
-                    fail(c, ":%ld: out of memory", line);
-                    goto done;
-                }
-                prev = cur;
-                n++;
-            }
-            if (n < 3) {
-                fail(c, ":%ld: face with %zu vertices (need at least 3)", line, n);
-                goto done;
-            }
-        }
-        /* everything else (vt, o, g, s, usemtl, mtllib, l, comments, ...) is ignored */
+        if (obj_line(&st, s) < 0) goto done;
     }
-    if (corners.n == 0) {
+    if (st.corners.n == 0)
         fail(c, ": no faces");
-        goto done;
-    }
-    if (corners.n / 3 > UINT32_MAX / 3) {
+    else if (st.corners.n / 3 > UINT32_MAX / 3)
         fail(c, ": too many faces");
-        goto done;
-    }
-
-    int with_normals = 1;
-    for (size_t i = 0; i < corners.n && with_normals; i++)
-        with_normals = corners.c[i].nrm != UINT32_MAX;
-    if (!with_normals) {
-        for (size_t i = 0; i < pos.n; i++)
-            if (mesh_add_vertex(&m, pos.v[i]) == UINT32_MAX) goto oom;
-        for (size_t i = 0; i < corners.n; i += 3)
-            if (mesh_add_triangle(&m, corners.c[i].pos, corners.c[i + 1].pos,
-                                  corners.c[i + 2].pos) < 0)
-                goto oom;
-    } else {
-        if (mesh_enable_normals(&m) < 0) goto oom;
-        uint32_t t[3];
-        for (size_t i = 0; i < corners.n; i++) {
-            Corner k = corners.c[i];
-            uint32_t v = m.nverts;
-            int r = pairmap_get(&pm, (uint64_t)k.pos << 32 | k.nrm, &v);
-            if (r < 0) goto oom;
-            if (r == 0) {
-                if (mesh_add_vertex(&m, pos.v[k.pos]) == UINT32_MAX) goto oom;
-                m.normals[v] = nrm.v[k.nrm];
-            }
-            t[i % 3] = v;
-            if (i % 3 == 2 && mesh_add_triangle(&m, t[0], t[1], t[2]) < 0) goto oom;
-        }
-    }
-    if (move_into(out, &m) < 0) goto oom;
-    rc = 0;
-    goto done;
-oom:
-    fail(c, ": out of memory");
+    else if (obj_mesh(&st, &m) < 0 || move_into(out, &m) < 0)
+        fail(c, ": out of memory");
+    else
+        rc = 0;
 done:
     mesh_free(&m);
-    free(pos.v);
-    free(nrm.v);
-    free(corners.c);
-    free(pm.keys);
-    free(pm.vals);
+    free(st.pos.v);
+    free(st.nrm.v);
+    free(st.corners.c);
     return rc;
 }
-
 /* ---- PLY ---- */
 
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
