@@ -267,123 +267,144 @@ static int obj_corner(const Ctx *c, long line, char **s, size_t npos, size_t nnr
     return 0;
 }
 
+/* OBJ parser state: what the lines read so far gave. */
+typedef struct ObjState {
+    const Ctx *c;
+    long line;
+    Vec3List pos, nrm;
+    CornerList corners; /* 3 per triangle */
+    size_t ntex;
+} ObjState;
+
+/* "v x y z [w | r g b [a]]" or "vn x y z"; s points past the keyword. */
+static int obj_vertex(ObjState *st, char *s, int is_v)
+{
+    const char *kw = is_v ? "v" : "vn";
+    float xyz[3], extra;
+    int r = 0, got = 0, nextra = 0;
+    while (got < 3 && (r = parse_float(&s, &xyz[got])) == 0) got++;
+    while (r == 0 && (r = parse_float(&s, &extra)) == 0) nextra++;
+    if (r == -2) return fail(st->c, ":%ld: non-finite number after '%s'", st->line, kw);
+    if (r != 1 || got < 3 || nextra > (is_v ? 4 : 0))
+        return fail(st->c, ":%ld: expected 3 numbers after '%s'", st->line, kw);
+    vec3 q = v3(xyz[0], xyz[1], xyz[2]);
+    if (vec3list_push(is_v ? &st->pos : &st->nrm, is_v ? q : v3_norm(q)) < 0)
+        return fail(st->c, ":%ld: too many vertices or out of memory", st->line);
+    return 0;
+}
+
+/* "f c1 c2 c3 ...": a polygon, kept as a fan of triangles (3 corners each). */
+static int obj_face(ObjState *st, char *s)
+{
+    Corner first = {0, 0}, prev = {0, 0}, cur;
+    size_t n = 0;
+    for (;;) {
+        s = skip_space(s);
+        if (*s == '\0') break;
+        if (obj_corner(st->c, st->line, &s, st->pos.n, st->nrm.n, st->ntex, &cur) < 0) return -1;
+        if (n == 0)
+            first = cur;
+        else if (n >= 2 && (cornerlist_push(&st->corners, first) < 0 ||
+                            cornerlist_push(&st->corners, prev) < 0 ||
+                            cornerlist_push(&st->corners, cur) < 0))
+            return fail(st->c, ":%ld: out of memory", st->line);
+        prev = cur;
+        n++;
+    }
+    if (n < 3) return fail(st->c, ":%ld: face with %zu vertices (need at least 3)", st->line, n);
+    return 0;
+}
+
+/* One NUL-terminated line, by its keyword. */
+static int obj_line(ObjState *st, char *s)
+{
+    char *kw = skip_space(s);
+    s = kw;
+    while (*s && !is_space(*s)) s++;
+    size_t kwlen = (size_t)(s - kw);
+    if (kwlen == 1 && kw[0] == 'v') return obj_vertex(st, s, 1);
+    if (kwlen == 2 && kw[0] == 'v' && kw[1] == 'n') return obj_vertex(st, s, 0);
+    if (kwlen == 2 && kw[0] == 'v' && kw[1] == 't') {
+        st->ntex++;
+        return 0;
+    }
+    if (kwlen == 1 && kw[0] == 'f') return obj_face(st, s);
+    /* everything else (vt, o, g, s, usemtl, mtllib, l, comments, ...) is ignored */
+    return 0;
+}
+
+/* Every corner has a normal: one mesh vertex per distinct (position, normal) pair.
+ * Returns -1 when out of memory. */
+static int obj_mesh_normals(const ObjState *st, Mesh *m)
+{
+    const CornerList *cl = &st->corners;
+    PairMap pm = {0};
+    uint32_t t[3];
+    size_t i;
+    if (mesh_enable_normals(m) < 0) return -1;
+    for (i = 0; i < cl->n; i++) {
+        Corner k = cl->c[i];
+        uint32_t v = m->nverts;
+        int r = pairmap_get(&pm, (uint64_t)k.pos << 32 | k.nrm, &v);
+        if (r < 0) break;
+        if (r == 0) {
+            if (mesh_add_vertex(m, st->pos.v[k.pos]) == UINT32_MAX) break;
+            m->normals[v] = st->nrm.v[k.nrm];
+        }
+        t[i % 3] = v;
+        if (i % 3 == 2 && mesh_add_triangle(m, t[0], t[1], t[2]) < 0) break;
+    }
+    free(pm.keys);
+    free(pm.vals);
+    return i == cl->n ? 0 : -1;
+}
+
+/* Builds the mesh from the corners: the positions as they are when any corner lacks a
+ * normal, else with normals. Returns -1 when out of memory. */
+static int obj_mesh(const ObjState *st, Mesh *m)
+{
+    const CornerList *cl = &st->corners;
+    int with_normals = 1;
+    for (size_t i = 0; i < cl->n && with_normals; i++) with_normals = cl->c[i].nrm != UINT32_MAX;
+    if (with_normals) return obj_mesh_normals(st, m);
+    for (size_t i = 0; i < st->pos.n; i++)
+        if (mesh_add_vertex(m, st->pos.v[i]) == UINT32_MAX) return -1;
+    for (size_t i = 0; i < cl->n; i += 3)
+        if (mesh_add_triangle(m, cl->c[i].pos, cl->c[i + 1].pos, cl->c[i + 2].pos) < 0) return -1;
+    return 0;
+}
+
 static int load_obj(const Ctx *c, char *data, size_t len, Mesh *out)
 {
-    Vec3List pos = {0}, nrm = {0};
-    CornerList corners = {0}; /* 3 per triangle */
-    PairMap pm = {0};
+    ObjState st = {.c = c};
     Mesh m;
-    size_t ntex = 0;
     int rc = -1;
-    long line = 0;
     char *p = data, *endp = data + len;
     mesh_init(&m);
     while (p < endp) {
-        line++;
+        st.line++;
         char *eol = memchr(p, '\n', (size_t)(endp - p));
         if (!eol) eol = endp;
         *eol = '\0';
-        char *s = skip_space(p), *kw = s;
+        char *s = p;
         p = eol + 1;
-        while (*s && !is_space(*s)) s++;
-        size_t kwlen = (size_t)(s - kw);
-        int is_v = kwlen == 1 && kw[0] == 'v', is_vn = kwlen == 2 && kw[0] == 'v' && kw[1] == 'n';
-        if (is_v || is_vn) {
-            /* v x y z [w | r g b [a]]; vn x y z */
-            float xyz[3], extra;
-            int r = 0, got = 0, nextra = 0;
-            while (got < 3 && (r = parse_float(&s, &xyz[got])) == 0) got++;
-            while (r == 0 && (r = parse_float(&s, &extra)) == 0) nextra++;
-            if (r == -2) {
-                fail(c, ":%ld: non-finite number after '%s'", line, is_v ? "v" : "vn");
-                goto done;
-            }
-            if (r != 1 || got < 3 || nextra > (is_v ? 4 : 0)) {
-                fail(c, ":%ld: expected 3 numbers after '%s'", line, is_v ? "v" : "vn");
-                goto done;
-            }
-            vec3 q = v3(xyz[0], xyz[1], xyz[2]);
-            if (vec3list_push(is_v ? &pos : &nrm, is_v ? q : v3_norm(q)) < 0) {
-                fail(c, ":%ld: too many vertices or out of memory", line);
-                goto done;
-            }
-        } else if (kwlen == 2 && kw[0] == 'v' && kw[1] == 't') {
-            ntex++;
-        } else if (kwlen == 1 && kw[0] == 'f') {
-            Corner first = {0, 0}, prev = {0, 0}, cur;
-            size_t n = 0;
-            for (;;) {
-                s = skip_space(s);
-                if (*s == '\0') break;
-                if (obj_corner(c, line, &s, pos.n, nrm.n, ntex, &cur) < 0) goto done;
-                if (n == 0)
-                    first = cur;
-                else if (n >= 2 && (cornerlist_push(&corners, first) < 0 ||
-                                    cornerlist_push(&corners, prev) < 0 ||
-                                    cornerlist_push(&corners, cur) < 0)) {
-                    fail(c, ":%ld: out of memory", line);
-                    goto done;
-                }
-                prev = cur;
-                n++;
-            }
-            if (n < 3) {
-                fail(c, ":%ld: face with %zu vertices (need at least 3)", line, n);
-                goto done;
-            }
-        }
-        /* everything else (vt, o, g, s, usemtl, mtllib, l, comments, ...) is ignored */
+        if (obj_line(&st, s) < 0) goto done;
     }
-    if (corners.n == 0) {
+    if (st.corners.n == 0)
         fail(c, ": no faces");
-        goto done;
-    }
-    if (corners.n / 3 > UINT32_MAX / 3) {
+    else if (st.corners.n / 3 > UINT32_MAX / 3)
         fail(c, ": too many faces");
-        goto done;
-    }
-
-    int with_normals = 1;
-    for (size_t i = 0; i < corners.n && with_normals; i++)
-        with_normals = corners.c[i].nrm != UINT32_MAX;
-    if (!with_normals) {
-        for (size_t i = 0; i < pos.n; i++)
-            if (mesh_add_vertex(&m, pos.v[i]) == UINT32_MAX) goto oom;
-        for (size_t i = 0; i < corners.n; i += 3)
-            if (mesh_add_triangle(&m, corners.c[i].pos, corners.c[i + 1].pos,
-                                  corners.c[i + 2].pos) < 0)
-                goto oom;
-    } else {
-        if (mesh_enable_normals(&m) < 0) goto oom;
-        uint32_t t[3];
-        for (size_t i = 0; i < corners.n; i++) {
-            Corner k = corners.c[i];
-            uint32_t v = m.nverts;
-            int r = pairmap_get(&pm, (uint64_t)k.pos << 32 | k.nrm, &v);
-            if (r < 0) goto oom;
-            if (r == 0) {
-                if (mesh_add_vertex(&m, pos.v[k.pos]) == UINT32_MAX) goto oom;
-                m.normals[v] = nrm.v[k.nrm];
-            }
-            t[i % 3] = v;
-            if (i % 3 == 2 && mesh_add_triangle(&m, t[0], t[1], t[2]) < 0) goto oom;
-        }
-    }
-    if (move_into(out, &m) < 0) goto oom;
-    rc = 0;
-    goto done;
-oom:
-    fail(c, ": out of memory");
+    else if (obj_mesh(&st, &m) < 0 || move_into(out, &m) < 0)
+        fail(c, ": out of memory");
+    else
+        rc = 0;
 done:
     mesh_free(&m);
-    free(pos.v);
-    free(nrm.v);
-    free(corners.c);
-    free(pm.keys);
-    free(pm.vals);
+    free(st.pos.v);
+    free(st.nrm.v);
+    free(st.corners.c);
     return rc;
 }
-
 /* ---- PLY ---- */
 
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
@@ -544,322 +565,327 @@ static int split_tokens(char *s, char **tok, int max)
     }
 }
 
-static int load_ply(const Ctx *c, char *data, size_t len, Mesh *out)
-{
-    PlyElement *els = calloc(PLY_MAX_ELEMENTS, sizeof *els);
-    if (!els) return fail(c, ": out of memory");
-    int nels = 0, format = -1, rc = -1;
-    long line = 0;
-    char *p = data, *endp = data + len;
-    Mesh m;
-    mesh_init(&m);
+/* What the header says: the elements in file order and the body's format. */
+typedef struct PlyHeader {
+    PlyElement *els; /* PLY_MAX_ELEMENTS of them */
+    int nels;
+    int format;            /* FMT_*, -1 until the format line */
+    long line;             /* the header line being read; at the end, end_header's */
+    PlyElement *vel, *fel; /* the vertex and face elements */
+    int has_normals;
+} PlyHeader;
 
-    /* header */
+/* "format FORMAT 1.0" */
+static int ply_format_line(const Ctx *c, PlyHeader *h, char **tok, int nt)
+{
+    if (nt != 3 || strcmp(tok[2], "1.0") != 0)
+        return fail(c, ": line %ld of header: expected 'format FORMAT 1.0'", h->line);
+    if (strcmp(tok[1], "ascii") == 0)
+        h->format = FMT_ASCII;
+    else if (strcmp(tok[1], "binary_little_endian") == 0)
+        h->format = FMT_LE;
+    else if (strcmp(tok[1], "binary_big_endian") == 0)
+        h->format = FMT_BE;
+    else
+        return fail(c, ": line %ld of header: unknown format '%s'", h->line, tok[1]);
+    return 0;
+}
+
+/* "element NAME COUNT" */
+static int ply_element_line(const Ctx *c, PlyHeader *h, char **tok, int nt)
+{
+    if (nt != 3) return fail(c, ": line %ld of header: expected 'element NAME COUNT'", h->line);
+    if (h->nels == PLY_MAX_ELEMENTS)
+        return fail(c, ": line %ld of header: too many elements", h->line);
+    char *end;
+    errno = 0;
+    unsigned long long cnt = strtoull(tok[2], &end, 10);
+    if (tok[2][0] < '0' || tok[2][0] > '9' || *end != '\0')
+        return fail(c, ": line %ld of header: bad element count '%s'", h->line, tok[2]);
+    if (errno == ERANGE || cnt > 0x7fffffffull)
+        return fail(c, ": line %ld of header: element count %s too large", h->line, tok[2]);
+    PlyElement *el = &h->els[h->nels++];
+    snprintf(el->name, sizeof el->name, "%s", tok[1]);
+    el->count = cnt;
+    el->kind = strcmp(tok[1], "vertex") == 0 ? 1 : strcmp(tok[1], "face") == 0 ? 2 : 0;
+    for (int i = 0; i < h->nels - 1; i++)
+        if (el->kind && h->els[i].kind == el->kind)
+            return fail(c, ": line %ld of header: second '%s' element", h->line, tok[1]);
+    return 0;
+}
+
+/* The types of "property TYPE NAME" or "property list COUNT ITEM NAME"; *name is NAME. */
+static int ply_prop_types(const Ctx *c, long line, char **tok, int nt, PlyProp *pr,
+                          const char **name)
+{
+    if (nt >= 2 && strcmp(tok[1], "list") == 0) {
+        if (nt != 5)
+            return fail(c, ": line %ld of header: expected 'property list COUNT ITEM NAME'", line);
+        pr->count_type = ply_type(tok[2]);
+        pr->type = ply_type(tok[3]);
+        for (int k = 2; k <= 3; k++)
+            if (ply_type(tok[k]) == T_NONE)
+                return fail(c, ": line %ld of header: unknown property type '%s'", line, tok[k]);
+        if (pr->count_type >= T_F32)
+            return fail(c, ": line %ld of header: list count type '%s' is not an integer", line,
+                        tok[2]);
+        *name = tok[4];
+        return 0;
+    }
+    if (nt != 3) return fail(c, ": line %ld of header: expected 'property TYPE NAME'", line);
+    pr->type = ply_type(tok[1]);
+    pr->count_type = T_NONE;
+    if (pr->type == T_NONE)
+        return fail(c, ": line %ld of header: unknown property type '%s'", line, tok[1]);
+    *name = tok[2];
+    return 0;
+}
+
+/* The role of property pr, named name, of element el: a vertex coordinate or normal
+ * component, or a face's vertex indices, each at most once and of the right shape. */
+static int ply_prop_role(const Ctx *c, long line, const PlyElement *el, PlyProp *pr,
+                         const char *name)
+{
+    pr->role = ROLE_NONE;
+    if (el->kind == 1) {
+        static const char *vnames[] = {"x", "y", "z", "nx", "ny", "nz"};
+        for (int k = 0; k < 6; k++)
+            if (strcmp(name, vnames[k]) == 0) pr->role = ROLE_X + k;
+    } else if (el->kind == 2) {
+        if (strcmp(name, "vertex_indices") == 0 || strcmp(name, "vertex_index") == 0)
+            pr->role = ROLE_INDICES;
+    }
+    if (pr->role == ROLE_NONE) return 0;
+    for (int k = 0; k < el->nprops; k++)
+        if (el->props[k].role == pr->role)
+            return fail(c, ": line %ld of header: property '%s' given twice", line, name);
+    if ((pr->role == ROLE_INDICES) != (pr->count_type != T_NONE))
+        return fail(c, ": line %ld of header: property '%s' must %sbe a list", line, name,
+                    pr->role == ROLE_INDICES ? "" : "not ");
+    if (pr->role == ROLE_INDICES && pr->type >= T_F32)
+        return fail(c, ": line %ld of header: vertex indices must be integers", line);
+    return 0;
+}
+
+/* "property ...", added to the last element */
+static int ply_property_line(const Ctx *c, PlyHeader *h, char **tok, int nt)
+{
+    if (h->nels == 0) return fail(c, ": line %ld of header: property before any element", h->line);
+    PlyElement *el = &h->els[h->nels - 1];
+    if (el->nprops == PLY_MAX_PROPS)
+        return fail(c, ": line %ld of header: too many properties", h->line);
+    PlyProp *pr = &el->props[el->nprops];
+    const char *name = NULL;
+    if (ply_prop_types(c, h->line, tok, nt, pr, &name) < 0 ||
+        ply_prop_role(c, h->line, el, pr, name) < 0)
+        return -1;
+    el->nprops++;
+    return 0;
+}
+
+/* Reads the header up to end_header; *p is left at the body. */
+static int ply_header(const Ctx *c, PlyHeader *h, char **p, char *endp)
+{
     for (;;) {
-        if (p >= endp) {
-            fail(c, ": header has no end_header");
-            goto done;
-        }
-        line++;
-        char *eol = memchr(p, '\n', (size_t)(endp - p));
+        if (*p >= endp) return fail(c, ": header has no end_header");
+        h->line++;
+        char *eol = memchr(*p, '\n', (size_t)(endp - *p));
         if (!eol) eol = endp;
         *eol = '\0';
-        char *s = p;
-        p = eol < endp ? eol + 1 : endp;
-        if (line == 1) {
+        char *s = *p;
+        *p = eol < endp ? eol + 1 : endp;
+        if (h->line == 1) {
             char *t = skip_space(s);
-            if (strncmp(t, "ply", 3) != 0 || *skip_space(t + 3) != '\0') {
-                fail(c, ": not a PLY file (first line is not 'ply')");
-                goto done;
-            }
+            if (strncmp(t, "ply", 3) != 0 || *skip_space(t + 3) != '\0')
+                return fail(c, ": not a PLY file (first line is not 'ply')");
             continue;
         }
         char *tok[8];
-        int nt = split_tokens(s, tok, 6);
+        int nt = split_tokens(s, tok, 6), r;
         if (nt == 0) continue;
         if (strcmp(tok[0], "comment") == 0 || strcmp(tok[0], "obj_info") == 0) continue;
         if (strcmp(tok[0], "end_header") == 0) break;
-        if (strcmp(tok[0], "format") == 0) {
-            if (nt != 3 || strcmp(tok[2], "1.0") != 0) {
-                fail(c, ": line %ld of header: expected 'format FORMAT 1.0'", line);
-                goto done;
-            }
-            if (strcmp(tok[1], "ascii") == 0)
-                format = FMT_ASCII;
-            else if (strcmp(tok[1], "binary_little_endian") == 0)
-                format = FMT_LE;
-            else if (strcmp(tok[1], "binary_big_endian") == 0)
-                format = FMT_BE;
-            else {
-                fail(c, ": line %ld of header: unknown format '%s'", line, tok[1]);
-                goto done;
-            }
-        } else if (strcmp(tok[0], "element") == 0) {
-            if (nt != 3) {
-                fail(c, ": line %ld of header: expected 'element NAME COUNT'", line);
-                goto done;
-            }
-            if (nels == PLY_MAX_ELEMENTS) {
-                fail(c, ": line %ld of header: too many elements", line);
-                goto done;
-            }
-            char *end;
-            errno = 0;
-            unsigned long long cnt = strtoull(tok[2], &end, 10);
-            if (tok[2][0] < '0' || tok[2][0] > '9' || *end != '\0') {
-                fail(c, ": line %ld of header: bad element count '%s'", line, tok[2]);
-                goto done;
-            }
-            if (errno == ERANGE || cnt > 0x7fffffffull) {
-                fail(c, ": line %ld of header: element count %s too large", line, tok[2]);
-                goto done;
-            }
-            PlyElement *el = &els[nels++];
-            snprintf(el->name, sizeof el->name, "%s", tok[1]);
-            el->count = cnt;
-            el->kind = strcmp(tok[1], "vertex") == 0 ? 1 : strcmp(tok[1], "face") == 0 ? 2 : 0;
-            for (int i = 0; i < nels - 1; i++)
-                if (el->kind && els[i].kind == el->kind) {
-                    fail(c, ": line %ld of header: second '%s' element", line, tok[1]);
-                    goto done;
-                }
-        } else if (strcmp(tok[0], "property") == 0) {
-            if (nels == 0) {
-                fail(c, ": line %ld of header: property before any element", line);
-                goto done;
-            }
-            PlyElement *el = &els[nels - 1];
-            if (el->nprops == PLY_MAX_PROPS) {
-                fail(c, ": line %ld of header: too many properties", line);
-                goto done;
-            }
-            PlyProp *pr = &el->props[el->nprops];
-            const char *name;
-            if (nt >= 2 && strcmp(tok[1], "list") == 0) {
-                if (nt != 5) {
-                    fail(c, ": line %ld of header: expected 'property list COUNT ITEM NAME'", line);
-                    goto done;
-                }
-                pr->count_type = ply_type(tok[2]);
-                pr->type = ply_type(tok[3]);
-                for (int k = 2; k <= 3; k++)
-                    if (ply_type(tok[k]) == T_NONE) {
-                        fail(c, ": line %ld of header: unknown property type '%s'", line, tok[k]);
-                        goto done;
-                    }
-                if (pr->count_type >= T_F32) {
-                    fail(c, ": line %ld of header: list count type '%s' is not an integer", line,
-                         tok[2]);
-                    goto done;
-                }
-                name = tok[4];
-            } else {
-                if (nt != 3) {
-                    fail(c, ": line %ld of header: expected 'property TYPE NAME'", line);
-                    goto done;
-                }
-                pr->type = ply_type(tok[1]);
-                pr->count_type = T_NONE;
-                if (pr->type == T_NONE) {
-                    fail(c, ": line %ld of header: unknown property type '%s'", line, tok[1]);
-                    goto done;
-                }
-                name = tok[2];
-            }
-            pr->role = ROLE_NONE;
-            if (el->kind == 1) {
-                static const char *vnames[] = {"x", "y", "z", "nx", "ny", "nz"};
-                for (int k = 0; k < 6; k++)
-                    if (strcmp(name, vnames[k]) == 0) pr->role = ROLE_X + k;
-            } else if (el->kind == 2) {
-                if (strcmp(name, "vertex_indices") == 0 || strcmp(name, "vertex_index") == 0)
-                    pr->role = ROLE_INDICES;
-            }
-            if (pr->role != ROLE_NONE) {
-                for (int k = 0; k < el->nprops; k++)
-                    if (el->props[k].role == pr->role) {
-                        fail(c, ": line %ld of header: property '%s' given twice", line, name);
-                        goto done;
-                    }
-                if ((pr->role == ROLE_INDICES) != (pr->count_type != T_NONE)) {
-                    fail(c, ": line %ld of header: property '%s' must %sbe a list", line, name,
-                         pr->role == ROLE_INDICES ? "" : "not ");
-                    goto done;
-                }
-                if (pr->role == ROLE_INDICES && pr->type >= T_F32) {
-                    fail(c, ": line %ld of header: vertex indices must be integers", line);
-                    goto done;
-                }
-            }
-            el->nprops++;
-        } else {
-            fail(c, ": line %ld of header: unknown keyword '%s'", line, tok[0]);
-            goto done;
-        }
+        if (strcmp(tok[0], "format") == 0)
+            r = ply_format_line(c, h, tok, nt);
+        else if (strcmp(tok[0], "element") == 0)
+            r = ply_element_line(c, h, tok, nt);
+        else if (strcmp(tok[0], "property") == 0)
+            r = ply_property_line(c, h, tok, nt);
+        else
+            r = fail(c, ": line %ld of header: unknown keyword '%s'", h->line, tok[0]);
+        if (r < 0) return -1;
     }
-    if (format < 0) {
-        fail(c, ": header has no format line");
-        goto done;
-    }
+    if (h->format < 0) return fail(c, ": header has no format line");
+    return 0;
+}
 
-    /* what the header promises */
-    PlyElement *vel = NULL, *fel = NULL;
-    int has_normals = 0;
-    for (int i = 0; i < nels; i++) {
-        if (els[i].kind == 1) vel = &els[i];
-        if (els[i].kind == 2) fel = &els[i];
-    }
-    if (!vel) {
-        fail(c, ": no vertex element");
-        goto done;
-    }
-    {
-        int roles = 0;
-        for (int k = 0; k < vel->nprops; k++) roles |= 1 << vel->props[k].role;
-        int xyz = 1 << ROLE_X | 1 << ROLE_Y | 1 << ROLE_Z;
-        int nxyz = 1 << ROLE_NX | 1 << ROLE_NY | 1 << ROLE_NZ;
-        if ((roles & xyz) != xyz) {
-            fail(c, ": vertex element lacks x, y or z");
-            goto done;
+/* The least number of bytes each element needs must fit in the left bytes of the body,
+ * so absurd counts are refused before anything is allocated for them. */
+static int ply_check_sizes(const Ctx *c, const PlyHeader *h, double left)
+{
+    double acc = 0.0;
+    int exact = h->format != FMT_ASCII; /* acc is exact while no lists came before */
+    for (int i = 0; i < h->nels; i++) {
+        const PlyElement *el = &h->els[i];
+        double per = 0.0;
+        int fixed = 1;
+        for (int k = 0; k < el->nprops; k++) {
+            const PlyProp *pr = &el->props[k];
+            fixed &= pr->count_type == T_NONE;
+            if (h->format == FMT_ASCII)
+                per += 2.0; /* a digit and a separator */
+            else
+                per += type_size[pr->count_type != T_NONE ? pr->count_type : pr->type];
         }
-        has_normals = (roles & nxyz) == nxyz;
-    }
-    if (!fel || fel->count == 0) {
-        fail(c, ": no faces");
-        goto done;
-    }
-    {
-        int found = 0;
-        for (int k = 0; k < fel->nprops; k++) found |= fel->props[k].role == ROLE_INDICES;
-        if (!found) {
-            fail(c, ": face element has no 'vertex_indices' list");
-            goto done;
+        if (acc + per * (double)el->count > left + (h->format == FMT_ASCII)) {
+            if (exact && fixed && per > 0.0)
+                return fail(c, ": unexpected end of file in %s %llu", el->name,
+                            (unsigned long long)((left - acc) / per));
+            return fail(c,
+                        ": unexpected end of file: the header promises %llu '%s' items, more "
+                        "than the remaining %.0f bytes can hold",
+                        (unsigned long long)el->count, el->name, left);
         }
+        acc += per * (double)el->count;
+        exact &= fixed;
     }
-    /* the least number of bytes each element needs must fit in what is left of the file,
-     * so absurd counts are refused before anything is allocated for them */
-    {
-        double left = (double)(endp - p), acc = 0.0;
-        int exact = format != FMT_ASCII; /* acc is exact while no lists came before */
-        for (int i = 0; i < nels; i++) {
-            double per = 0.0;
-            int fixed = 1;
-            for (int k = 0; k < els[i].nprops; k++) {
-                const PlyProp *pr = &els[i].props[k];
-                fixed &= pr->count_type == T_NONE;
-                if (format == FMT_ASCII)
-                    per += 2.0; /* a digit and a separator */
-                else
-                    per += type_size[pr->count_type != T_NONE ? pr->count_type : pr->type];
-            }
-            if (acc + per * (double)els[i].count > left + (format == FMT_ASCII)) {
-                if (exact && fixed && per > 0.0)
-                    fail(c, ": unexpected end of file in %s %llu", els[i].name,
-                         (unsigned long long)((left - acc) / per));
-                else
-                    fail(c,
-                         ": unexpected end of file: the header promises %llu '%s' items, more "
-                         "than the remaining %.0f bytes can hold",
-                         (unsigned long long)els[i].count, els[i].name, left);
-                goto done;
-            }
-            acc += per * (double)els[i].count;
-            exact &= fixed;
-        }
-    }
-    if (vel->count >= UINT32_MAX) {
-        fail(c, ": too many vertices");
-        goto done;
-    }
-    if (has_normals && mesh_enable_normals(&m) < 0) goto oom;
+    return 0;
+}
 
-    /* body */
-    PlyReader r = {c,  format, (const unsigned char *)p, (const unsigned char *)endp, line + 1,
-                   "", 0};
-    uint32_t nverts = (uint32_t)vel->count;
-    for (int i = 0; i < nels; i++) {
-        PlyElement *el = &els[i];
+/* What the header promises: vertices with x, y and z, faces with vertex indices, and no
+ * more elements than the left bytes of the body can hold. */
+static int ply_check_header(const Ctx *c, PlyHeader *h, double left)
+{
+    for (int i = 0; i < h->nels; i++) {
+        if (h->els[i].kind == 1) h->vel = &h->els[i];
+        if (h->els[i].kind == 2) h->fel = &h->els[i];
+    }
+    if (!h->vel) return fail(c, ": no vertex element");
+    int roles = 0;
+    for (int k = 0; k < h->vel->nprops; k++) roles |= 1 << h->vel->props[k].role;
+    int xyz = 1 << ROLE_X | 1 << ROLE_Y | 1 << ROLE_Z;
+    int nxyz = 1 << ROLE_NX | 1 << ROLE_NY | 1 << ROLE_NZ;
+    if ((roles & xyz) != xyz) return fail(c, ": vertex element lacks x, y or z");
+    h->has_normals = (roles & nxyz) == nxyz;
+    if (!h->fel || h->fel->count == 0) return fail(c, ": no faces");
+    int found = 0;
+    for (int k = 0; k < h->fel->nprops; k++) found |= h->fel->props[k].role == ROLE_INDICES;
+    if (!found) return fail(c, ": face element has no 'vertex_indices' list");
+    if (ply_check_sizes(c, h, left) < 0) return -1;
+    if (h->vel->count >= UINT32_MAX) return fail(c, ": too many vertices");
+    return 0;
+}
+
+/* Reads one scalar property; a vertex's coordinates and normal are kept in vals. */
+static int ply_scalar(PlyReader *r, const PlyProp *pr, float *vals)
+{
+    double d;
+    if (ply_value(r, pr->type, &d) < 0) return -1;
+    if (pr->role == ROLE_NONE) return 0;
+    if (!isfinite(d) || fabs(d) > 3.4028234663852886e38) {
+        char where[96];
+        ply_where(r, where, sizeof where);
+        return fail(r->c, "%s: non-finite coordinate", where);
+    }
+    vals[pr->role] = (float)d;
+    return 0;
+}
+
+/* Reads one list property; a face's vertex indices (of nverts vertices) are added to m as
+ * a fan of triangles. */
+static int ply_list(PlyReader *r, const PlyProp *pr, uint32_t nverts, Mesh *m)
+{
+    char where[96];
+    double d;
+    if (ply_value(r, pr->count_type, &d) < 0) return -1;
+    if (d < 0) {
+        ply_where(r, where, sizeof where);
+        return fail(r->c, "%s: negative list length", where);
+    }
+    uint64_t n = (uint64_t)d;
+    if (r->format != FMT_ASCII && (uint64_t)(r->end - r->p) / (uint64_t)type_size[pr->type] < n)
+        return ply_eof(r);
+    if (pr->role == ROLE_INDICES && n < 3) {
+        ply_where(r, where, sizeof where);
+        return fail(r->c, "%s: has %llu vertices (need at least 3)", where, (unsigned long long)n);
+    }
+    uint32_t first = 0, prev = 0;
+    for (uint64_t j = 0; j < n; j++) {
+        if (ply_value(r, pr->type, &d) < 0) return -1;
+        if (pr->role != ROLE_INDICES) continue;
+        if (d < 0 || d >= (double)nverts) {
+            ply_where(r, where, sizeof where);
+            return fail(r->c, "%s: index %.0f out of range (%u vertices)", where, d, nverts);
+        }
+        uint32_t v = (uint32_t)d;
+        if (j == 0)
+            first = v;
+        else if (j >= 2 && mesh_add_triangle(m, first, prev, v) < 0)
+            return fail(r->c, ": out of memory");
+        prev = v;
+    }
+    return 0;
+}
+
+/* Reads one item of element el; a vertex is added to m. */
+static int ply_item(PlyReader *r, const PlyHeader *h, const PlyElement *el, Mesh *m)
+{
+    float vals[7] = {0};
+    uint32_t nverts = (uint32_t)h->vel->count;
+    for (int k = 0; k < el->nprops; k++) {
+        const PlyProp *pr = &el->props[k];
+        if ((pr->count_type == T_NONE ? ply_scalar(r, pr, vals) : ply_list(r, pr, nverts, m)) < 0)
+            return -1;
+    }
+    if (el != h->vel) return 0;
+    uint32_t v = mesh_add_vertex(m, v3(vals[ROLE_X], vals[ROLE_Y], vals[ROLE_Z]));
+    if (v == UINT32_MAX) return fail(r->c, ": out of memory");
+    if (h->has_normals) m->normals[v] = v3_norm(v3(vals[ROLE_NX], vals[ROLE_NY], vals[ROLE_NZ]));
+    return 0;
+}
+
+/* Reads the body, from p to endp, into m. */
+static int ply_body(const Ctx *c, const PlyHeader *h, char *p, char *endp, Mesh *m)
+{
+    PlyReader r = {
+        c, h->format, (const unsigned char *)p, (const unsigned char *)endp, h->line + 1, "", 0};
+    for (int i = 0; i < h->nels; i++) {
+        const PlyElement *el = &h->els[i];
         r.what = el->name;
         for (uint64_t it = 0; it < el->count; it++) {
             r.item = it;
-            float vals[7] = {0};
-            uint32_t first = 0, prev = 0;
-            for (int k = 0; k < el->nprops; k++) {
-                const PlyProp *pr = &el->props[k];
-                double d;
-                if (pr->count_type == T_NONE) {
-                    if (ply_value(&r, pr->type, &d) < 0) goto done;
-                    if (pr->role != ROLE_NONE) {
-                        if (!isfinite(d) || fabs(d) > 3.4028234663852886e38) {
-                            char where[96];
-                            ply_where(&r, where, sizeof where);
-                            fail(c, "%s: non-finite coordinate", where);
-                            goto done;
-                        }
-                        vals[pr->role] = (float)d;
-                    }
-                    continue;
-                }
-                if (ply_value(&r, pr->count_type, &d) < 0) goto done;
-                if (d < 0) {
-                    char where[96];
-                    ply_where(&r, where, sizeof where);
-                    fail(c, "%s: negative list length", where);
-                    goto done;
-                }
-                uint64_t n = (uint64_t)d;
-                if (format != FMT_ASCII &&
-                    (uint64_t)(r.end - r.p) / (uint64_t)type_size[pr->type] < n) {
-                    ply_eof(&r);
-                    goto done;
-                }
-                if (pr->role == ROLE_INDICES && n < 3) {
-                    char where[96];
-                    ply_where(&r, where, sizeof where);
-                    fail(c, "%s: has %llu vertices (need at least 3)", where,
-                         (unsigned long long)n);
-                    goto done;
-                }
-                for (uint64_t j = 0; j < n; j++) {
-                    if (ply_value(&r, pr->type, &d) < 0) goto done;
-                    if (pr->role != ROLE_INDICES) continue;
-                    if (d < 0 || d >= (double)nverts) {
-                        char where[96];
-                        ply_where(&r, where, sizeof where);
-                        fail(c, "%s: index %.0f out of range (%u vertices)", where, d, nverts);
-                        goto done;
-                    }
-                    uint32_t v = (uint32_t)d;
-                    if (j == 0)
-                        first = v;
-                    else if (j >= 2 && mesh_add_triangle(&m, first, prev, v) < 0)
-                        goto oom;
-                    prev = v;
-                }
-            }
-            if (el == vel) {
-                uint32_t v = mesh_add_vertex(&m, v3(vals[ROLE_X], vals[ROLE_Y], vals[ROLE_Z]));
-                if (v == UINT32_MAX) goto oom;
-                if (has_normals)
-                    m.normals[v] = v3_norm(v3(vals[ROLE_NX], vals[ROLE_NY], vals[ROLE_NZ]));
-            }
+            if (ply_item(&r, h, el, m) < 0) return -1;
         }
     }
-    if (m.ntris == 0) {
-        fail(c, ": no faces");
-        goto done;
-    }
-    if (move_into(out, &m) < 0) goto oom;
-    rc = 0;
-    goto done;
-oom:
-    fail(c, ": out of memory");
-done:
-    mesh_free(&m);
-    free(els);
-    return rc;
+    return 0;
 }
 
+static int load_ply(const Ctx *c, char *data, size_t len, Mesh *out)
+{
+    PlyHeader h = {.els = calloc(PLY_MAX_ELEMENTS, sizeof(PlyElement)), .format = -1};
+    if (!h.els) return fail(c, ": out of memory");
+    char *p = data, *endp = data + len;
+    int rc = -1;
+    Mesh m;
+    mesh_init(&m);
+    if (ply_header(c, &h, &p, endp) < 0 || ply_check_header(c, &h, (double)(endp - p)) < 0)
+        goto done;
+    if (h.has_normals && mesh_enable_normals(&m) < 0) {
+        fail(c, ": out of memory");
+        goto done;
+    }
+    if (ply_body(c, &h, p, endp, &m) < 0) goto done;
+    if (m.ntris == 0)
+        fail(c, ": no faces");
+    else if (move_into(out, &m) < 0)
+        fail(c, ": out of memory");
+    else
+        rc = 0;
+done:
+    mesh_free(&m);
+    free(h.els);
+    return rc;
+}
 int mesh_load(const char *path, Mesh *out, char *err, size_t errlen)
 {
     return mesh_load_head(path, out, NULL, 0, err, errlen);
