@@ -528,7 +528,7 @@ static int deform_sweep(const DeformParams *p, const Prof *pr, const Shape *s, i
         snprintf(err, errlen, "out of memory");
         return -2;
     }
-    for (int r = 0; r <= rings; r++) zs[r] = p->length * r / rings;
+    for (int r = 0; r <= rings; r++) zs[r] = (double)p->length * r / rings;
     int rc = deform_elements(p, pr, s, zs, rings, out);
     free(zs);
     if (rc == -3) {
