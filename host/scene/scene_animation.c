@@ -47,6 +47,86 @@ static int check_target(Ctx *c, const char *target, const char *path)
     return 0;
 }
 
+/* The element of the array node that seg names: by index, else by its "name"; -1 if none. */
+static int anim_element(const cJSON *node, const char *seg)
+{
+    char *end;
+    long i = strtol(seg, &end, 10);
+    int n = cJSON_GetArraySize(node);
+    if (*end == 0 && end != seg && i >= 0 && i < n) return (int)i;
+    for (int k = 0; k < n; k++) {
+        const cJSON *nm = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(node, k), "name");
+        if (cJSON_IsString(nm) && strcmp(nm->valuestring, seg) == 0) return k;
+    }
+    return -1;
+}
+
+/* Puts *val in place of the last member seg of node (its element index, or -1 for an
+ * object's member next, NULL when missing); *val becomes NULL once the tree holds it. */
+static int anim_put(Ctx *c, cJSON *node, const char *seg, int index, const cJSON *next,
+                    const char *target, const char *path, cJSON **val)
+{
+    if (next && !cJSON_IsNumber(next) && !cJSON_IsArray(next))
+        return scene_fail(c, path, "\"%s\" is a %s: only numbers and arrays of numbers animate",
+                          diag_value(target), json_type_name(next));
+    if (!*val) return 0;
+    cJSON_bool ok = index >= 0 ? cJSON_ReplaceItemInArray(node, index, *val)
+                    : next     ? cJSON_ReplaceItemInObjectCaseSensitive(node, seg, *val)
+                               : cJSON_AddItemToObject(node, seg, *val);
+    if (!ok) return scene_fail(c, NULL, "out of memory");
+    *val = NULL;
+    return 0;
+}
+
+/* anim_set's walk along the target's components; *val as in anim_put. */
+static int anim_walk(Ctx *c, cJSON *root, const char *target, const char *path, cJSON **val,
+                     char *canon)
+{
+    char buf[PATH_MAX_LEN];
+    strcpy(buf, target);
+    cJSON *node = root;
+    char *save = NULL;
+    int in_element = 0; /* below an element of an array (an object, a light) */
+    for (char *seg = strtok_r(buf, ".", &save); seg; seg = strtok_r(NULL, ".", &save)) {
+        int last = *save == 0, index = -1;
+        if (node == root && (strcmp(seg, "animation") == 0 || last))
+            return scene_fail(c, path,
+                              "\"%s\": expected a value inside image, camera, render, lights, "
+                              "materials or objects",
+                              diag_value(target));
+        cJSON *next = NULL;
+        size_t k = strlen(canon);
+        if (cJSON_IsArray(node)) {
+            if ((index = anim_element(node, seg)) < 0)
+                return scene_fail(c, path, "\"%s\": no element \"%s\" (an index or a name)",
+                                  diag_value(target), diag_value(seg));
+            next = cJSON_GetArrayItem(node, index);
+            in_element = 1;
+            snprintf(canon + k, PATH_MAX_LEN - k, "[%d]", index);
+        } else if (cJSON_IsObject(node)) {
+            next = cJSON_GetObjectItemCaseSensitive(node, seg);
+            snprintf(canon + k, PATH_MAX_LEN - k, "%s%s", k ? "." : "", seg);
+        } else {
+            return scene_fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array",
+                              diag_value(target), diag_value(seg), json_type_name(node));
+        }
+        if (last) return anim_put(c, node, seg, index, next, target, path, val);
+        if (!next && !in_element)
+            return scene_fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
+                              diag_value(seg));
+        if (!next) { /* a missing object on the way, inside an element (its transform) */
+            if (!*val) return 0; /* checking only: it would be created */
+            next = cJSON_CreateObject();
+            if (!next || !cJSON_AddItemToObject(node, seg, next)) {
+                cJSON_Delete(next);
+                return scene_fail(c, NULL, "out of memory");
+            }
+        }
+        node = next;
+    }
+    return scene_fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+}
+
 /* Sets the member a track's target names, "materials.glass.eta" or "objects.ball.transform.
  * rotate", to val (taken over; NULL only checks the path): object members by key, array
  * elements by index or by their "name". A missing last member is created (a setting left at
@@ -55,95 +135,10 @@ static int check_target(Ctx *c, const char *target, const char *path)
 static int anim_set(Ctx *c, cJSON *root, const char *target, const char *path, cJSON *val,
                     char *canon)
 {
-    char buf[PATH_MAX_LEN];
     canon[0] = 0;
-    if (check_target(c, target, path)) {
-        cJSON_Delete(val);
-        return -1;
-    }
-    strcpy(buf, target);
-    cJSON *node = root;
-    char *save = NULL;
-    int in_element = 0; /* below an element of an array (an object, a light) */
-    for (char *seg = strtok_r(buf, ".", &save); seg; seg = strtok_r(NULL, ".", &save)) {
-        int last = *save == 0;
-        if (node == root && (strcmp(seg, "animation") == 0 || last)) {
-            cJSON_Delete(val);
-            return scene_fail(c, path,
-                              "\"%s\": expected a value inside image, camera, render, lights, "
-                              "materials or objects",
-                              diag_value(target));
-        }
-        int index = -1;
-        cJSON *next = NULL;
-        if (cJSON_IsArray(node)) {
-            char *end;
-            long i = strtol(seg, &end, 10);
-            int n = cJSON_GetArraySize(node);
-            if (*end == 0 && end != seg && i >= 0 && i < n) index = (int)i;
-            for (int k = 0; index < 0 && k < n; k++) {
-                const cJSON *nm =
-                    cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(node, k), "name");
-                if (cJSON_IsString(nm) && strcmp(nm->valuestring, seg) == 0) index = k;
-            }
-            if (index < 0) {
-                cJSON_Delete(val);
-                return scene_fail(c, path, "\"%s\": no element \"%s\" (an index or a name)",
-                                  diag_value(target), diag_value(seg));
-            }
-            next = cJSON_GetArrayItem(node, index);
-            in_element = 1;
-            size_t k = strlen(canon);
-            snprintf(canon + k, PATH_MAX_LEN - k, "[%d]", index);
-        } else if (cJSON_IsObject(node)) {
-            next = cJSON_GetObjectItemCaseSensitive(node, seg);
-            size_t k = strlen(canon);
-            snprintf(canon + k, PATH_MAX_LEN - k, "%s%s", k ? "." : "", seg);
-            if (!next && node == root) {
-                cJSON_Delete(val);
-                return scene_fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
-                                  diag_value(seg));
-            }
-        } else {
-            cJSON_Delete(val);
-            return scene_fail(c, path, "\"%s\": \"%s\" is inside a %s, not an object or array",
-                              diag_value(target), diag_value(seg), json_type_name(node));
-        }
-        if (last) {
-            if (next && !cJSON_IsNumber(next) && !cJSON_IsArray(next)) {
-                cJSON_Delete(val);
-                return scene_fail(c, path,
-                                  "\"%s\" is a %s: only numbers and arrays of numbers animate",
-                                  diag_value(target), json_type_name(next));
-            }
-            if (!val) return 0;
-            cJSON_bool ok = index >= 0 ? cJSON_ReplaceItemInArray(node, index, val)
-                            : next     ? cJSON_ReplaceItemInObjectCaseSensitive(node, seg, val)
-                                       : cJSON_AddItemToObject(node, seg, val);
-            if (!ok) {
-                cJSON_Delete(val);
-                return scene_fail(c, NULL, "out of memory");
-            }
-            return 0;
-        }
-        if (!next && !in_element) {
-            cJSON_Delete(val);
-            return scene_fail(c, path, "\"%s\": no member \"%s\"", diag_value(target),
-                              diag_value(seg));
-        }
-        if (!next) {            /* a missing object on the way, inside an element (its transform) */
-            if (!val) return 0; /* checking only: it would be created */
-            next = cJSON_CreateObject();
-            if (!next || !cJSON_AddItemToObject(node, seg, next)) {
-                cJSON_Delete(next);
-                cJSON_Delete(val);
-                return scene_fail(c, NULL, "out of memory");
-            }
-        }
-        node = next;
-    }
+    int rc = check_target(c, target, path) ? -1 : anim_walk(c, root, target, path, &val, canon);
     cJSON_Delete(val);
-    return scene_fail(c, path, "expected a path such as \"materials.NAME.eta\"");
+    return rc;
 }
 
 /* Applies root.animation for frame `frame`, linearly between the keys around it and holding

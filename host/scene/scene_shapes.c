@@ -91,95 +91,109 @@ static int load_revolution(Ctx *c, const cJSON *o, const char *p, Mesh *m)
     return 0;
 }
 
+/* objects[i] with "shape": "mesh": a mesh file, relative to the scene's directory. */
+static int load_mesh_file(Ctx *c, const cJSON *o, const char *p, const Scene *s, Mesh *m)
+{
+    static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                       "texture", "file",     NULL};
+    char q[PATH_MAX_LEN];
+    if (json_check_keys(c, o, p, keys)) return -1;
+    json_path_key(q, p, "file");
+    const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "file");
+    if (!f) return scene_fail(c, q, "missing (expected a mesh file name)");
+    if (!cJSON_IsString(f) || !f->valuestring[0])
+        return scene_fail(c, q, "expected a file name, got %s", json_type_name(f));
+    char full[4096], merr[512];
+    scene_join_path(full, sizeof full, s->dir, f->valuestring);
+    if (mesh_load(full, m, merr, sizeof merr)) return scene_fail(c, q, "%s", merr);
+    return 0;
+}
+
+/* objects[i] with "shape": "sphere": a subdivided icosahedron of radius and centre. */
+static int load_sphere(Ctx *c, const cJSON *o, const char *p, Mesh *m)
+{
+    static const char *const keys[] = {"shape",  "material", "name",  "transform", "texture",
+                                       "radius", "centre",   "level", NULL};
+    static const float zero[3] = {0, 0, 0};
+    float radius, centre[3];
+    int level;
+    if (json_check_keys(c, o, p, keys) ||
+        json_get_float(c, o, p, "radius", FLT_MIN, FLT_MAX, 1, 0, &radius) ||
+        json_get_vec(c, o, p, "centre", 3, -FLT_MAX, FLT_MAX, zero, centre) ||
+        json_get_int(c, o, p, "level", 0, 7, 3, 0, &level))
+        return -1;
+    if (shape_sphere(m, level)) return 1;
+    mat4 xf = mat4_mul(mat4_translate(v3(centre[0], centre[1], centre[2])),
+                       mat4_scale(v3(radius, radius, radius)));
+    mesh_transform(m, &xf);
+    return 0;
+}
+
+/* objects[i] with "shape": "prism": a triangle [x, y] x 3 extruded by depth. */
+static int load_prism(Ctx *c, const cJSON *o, const char *p, Mesh *m)
+{
+    static const char *const keys[] = {"shape",   "material", "name",  "transform",
+                                       "texture", "points",   "depth", NULL};
+    char q[PATH_MAX_LEN];
+    float pts[3][2] = {{-0.5f, -0.288675f}, {0.5f, -0.288675f}, {0.0f, 0.577350f}};
+    float depth;
+    if (json_check_keys(c, o, p, keys) ||
+        json_get_float(c, o, p, "depth", FLT_MIN, FLT_MAX, 1, 0, &depth))
+        return -1;
+    const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "points");
+    json_path_key(q, p, "points");
+    if (pj) {
+        if (!cJSON_IsArray(pj) || cJSON_GetArraySize(pj) != 3)
+            return scene_fail(c, q, "expected 3 points [x, y]");
+        int i = 0;
+        for (const cJSON *e = pj->child; e; e = e->next, i++) {
+            char qi[PATH_MAX_LEN];
+            json_path_index(qi, q, i);
+            if (json_read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, pts[i])) return -1;
+        }
+    }
+    double area = (pts[1][0] - pts[0][0]) * (pts[2][1] - pts[0][1]) -
+                  (pts[2][0] - pts[0][0]) * (pts[1][1] - pts[0][1]);
+    if (area == 0) return scene_fail(c, q, "the three points are on one line");
+    return shape_prism(m, (const float(*)[2])pts, depth) ? 1 : 0;
+}
+
+/* objects[i] with "shape": "box" (3 sizes) or "quad" (2 sizes, in the xy plane). */
+static int load_box_or_quad(Ctx *c, const cJSON *o, const char *p, int quad, Mesh *m)
+{
+    static const char *const keys[] = {"shape",   "material", "name", "transform",
+                                       "texture", "size",     NULL};
+    static const float one[3] = {1, 1, 1};
+    float size[3];
+    if (json_check_keys(c, o, p, keys) ||
+        json_get_vec(c, o, p, "size", quad ? 2 : 3, FLT_MIN, FLT_MAX, one, size))
+        return -1;
+    int rc = quad ? shape_quad(m, size[0], size[1]) : shape_box(m, v3(size[0], size[1], size[2]));
+    return rc ? 1 : 0;
+}
+
 /* Tessellates one object's shape into m (object space). */
 int scene_load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, const Scene *s,
                      Mesh *m)
 {
-    char q[PATH_MAX_LEN];
-    int rc = 0;
-    if (strcmp(shape, "mesh") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform",
-                                           "texture", "file",     NULL};
-        if (json_check_keys(c, o, p, keys)) return -1;
-        json_path_key(q, p, "file");
-        const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "file");
-        if (!f) return scene_fail(c, q, "missing (expected a mesh file name)");
-        if (!cJSON_IsString(f) || !f->valuestring[0])
-            return scene_fail(c, q, "expected a file name, got %s", json_type_name(f));
-        char full[4096], merr[512];
-        scene_join_path(full, sizeof full, s->dir, f->valuestring);
-        if (mesh_load(full, m, merr, sizeof merr)) return scene_fail(c, q, "%s", merr);
-        return 0;
-    }
-    if (strcmp(shape, "sphere") == 0) {
-        static const char *const keys[] = {"shape",  "material", "name",  "transform", "texture",
-                                           "radius", "centre",   "level", NULL};
-        static const float zero[3] = {0, 0, 0};
-        float radius, centre[3];
-        int level;
-        if (json_check_keys(c, o, p, keys) ||
-            json_get_float(c, o, p, "radius", FLT_MIN, FLT_MAX, 1, 0, &radius) ||
-            json_get_vec(c, o, p, "centre", 3, -FLT_MAX, FLT_MAX, zero, centre) ||
-            json_get_int(c, o, p, "level", 0, 7, 3, 0, &level))
-            return -1;
-        rc = shape_sphere(m, level);
-        if (!rc) {
-            mat4 xf = mat4_mul(mat4_translate(v3(centre[0], centre[1], centre[2])),
-                               mat4_scale(v3(radius, radius, radius)));
-            mesh_transform(m, &xf);
-        }
-    } else if (strcmp(shape, "box") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform",
-                                           "texture", "size",     NULL};
-        static const float one[3] = {1, 1, 1};
-        float size[3];
-        if (json_check_keys(c, o, p, keys) ||
-            json_get_vec(c, o, p, "size", 3, FLT_MIN, FLT_MAX, one, size))
-            return -1;
-        rc = shape_box(m, v3(size[0], size[1], size[2]));
-    } else if (strcmp(shape, "prism") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name",  "transform",
-                                           "texture", "points",   "depth", NULL};
-        float pts[3][2] = {{-0.5f, -0.288675f}, {0.5f, -0.288675f}, {0.0f, 0.577350f}};
-        float depth;
-        if (json_check_keys(c, o, p, keys) ||
-            json_get_float(c, o, p, "depth", FLT_MIN, FLT_MAX, 1, 0, &depth))
-            return -1;
-        const cJSON *pj = cJSON_GetObjectItemCaseSensitive(o, "points");
-        json_path_key(q, p, "points");
-        if (pj) {
-            if (!cJSON_IsArray(pj) || cJSON_GetArraySize(pj) != 3)
-                return scene_fail(c, q, "expected 3 points [x, y]");
-            int i = 0;
-            for (const cJSON *e = pj->child; e; e = e->next, i++) {
-                char qi[PATH_MAX_LEN];
-                json_path_index(qi, q, i);
-                if (json_read_vec(c, e, qi, 2, -FLT_MAX, FLT_MAX, pts[i])) return -1;
-            }
-        }
-        double area = (pts[1][0] - pts[0][0]) * (pts[2][1] - pts[0][1]) -
-                      (pts[2][0] - pts[0][0]) * (pts[1][1] - pts[0][1]);
-        if (area == 0) return scene_fail(c, q, "the three points are on one line");
-        rc = shape_prism(m, (const float(*)[2])pts, depth);
-    } else if (strcmp(shape, "quad") == 0) {
-        static const char *const keys[] = {"shape",   "material", "name", "transform",
-                                           "texture", "size",     NULL};
-        static const float one[2] = {1, 1};
-        float size[2];
-        if (json_check_keys(c, o, p, keys) ||
-            json_get_vec(c, o, p, "size", 2, FLT_MIN, FLT_MAX, one, size))
-            return -1;
-        rc = shape_quad(m, size[0], size[1]);
-    } else if (strcmp(shape, "revolution") == 0) {
-        return load_revolution(c, o, p, m);
-    } else {
+    int rc; /* -1 reported, 1 out of memory while tessellating */
+    if (strcmp(shape, "mesh") == 0) return load_mesh_file(c, o, p, s, m);
+    if (strcmp(shape, "revolution") == 0) return load_revolution(c, o, p, m);
+    if (strcmp(shape, "sphere") == 0)
+        rc = load_sphere(c, o, p, m);
+    else if (strcmp(shape, "box") == 0 || strcmp(shape, "quad") == 0)
+        rc = load_box_or_quad(c, o, p, shape[0] == 'q', m);
+    else if (strcmp(shape, "prism") == 0)
+        rc = load_prism(c, o, p, m);
+    else {
+        char q[PATH_MAX_LEN];
         json_path_key(q, p, "shape");
         return scene_fail(
             c, q, "unknown shape \"%s\" (expected mesh, sphere, box, prism, quad or revolution)",
             diag_value(shape));
     }
-    if (rc) return scene_fail(c, p, "could not tessellate the shape (out of memory)");
-    return 0;
+    if (rc > 0) return scene_fail(c, p, "could not tessellate the shape (out of memory)");
+    return rc;
 }
 
 /* The triangles objects[i] will have, from its parameters alone (a mesh file's are known
