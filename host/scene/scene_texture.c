@@ -11,6 +11,7 @@
 
 #include "cache.h"
 #include "diag.h"
+#include "texgen.h"
 
 /* Maps the texture block [lo, hi] onto the box [host_lo, host_hi] through the unit cube
  * centred at the origin, where the texture's own transform applies. */
@@ -25,8 +26,6 @@ static mat4 texture_mapping(const float block[6], vec3 host_lo, vec3 host_hi, co
     mat4 to_host = mat4_mul(mat4_translate(hc), mat4_scale(he));
     return mat4_mul(to_host, mat4_mul(*xf, to_unit));
 }
-
-SceneTexgenFn scene_texgen;
 
 /* Reads the texture block a vbcl texgen file declares in its header ("# block x0 y0 z0 x1
  * y1 z1" in OBJ, "comment block ..." in PLY), from the file's first bytes `head`.
@@ -56,55 +55,125 @@ static int read_block_comment(const char *head, float block[6])
     return found;
 }
 
-/* Runs `vbcl texgen ARGS` for objects[i].texture.generate into the cache (or a temporary
- * file when the cache is off), unless the cache already holds it; writes its path. */
-static int generate_texture(Ctx *c, const char *q, const char *args, char *path, size_t n,
-                            int *temporary)
+int scene_texgen_enabled = 1;
+
+/* A mesh file of texture elements at path into tex, and the block its header declares
+ * (*has_declared 0 when none). */
+static int load_texture_file(Ctx *c, const char *q, const char *path, Mesh *tex, float declared[6],
+                             int *has_declared)
 {
-    char dir[4096], err[768];
+    char head[8192], merr[512];
+    if (mesh_load_head(path, tex, head, sizeof head, merr, sizeof merr))
+        return scene_fail(c, q, "%s", merr);
+    *has_declared = read_block_comment(head, declared);
+    return 0;
+}
+
+/* The generated set's elements as one mesh, exactly as writing it to PLY and reading it
+ * back gives it: elements in order, normals only when every element has them (unit
+ * length, as the reader makes them), the block when it is valid. */
+static int texset_to_mesh(Ctx *c, const char *q, const TexSet *t, Mesh *tex, float declared[6],
+                          int *has_declared)
+{
+    int normals = t->count > 0;
+    for (int e = 0; e < t->count; e++) {
+        if (mesh_append(tex, &t->elems[e])) return scene_fail(c, NULL, "out of memory");
+        normals = normals && t->elems[e].normals;
+    }
+    if (!normals) {
+        free(tex->normals);
+        tex->normals = NULL;
+    }
+    for (uint32_t v = 0; normals && v < tex->nverts; v++)
+        tex->normals[v] = v3_norm(tex->normals[v]);
+    if (tex->ntris == 0) return scene_fail(c, q, "the generated texture has no faces");
+    *has_declared = 1;
+    for (int i = 0; i < 3; i++) {
+        declared[i] = t->block_lo[i];
+        declared[i + 3] = t->block_hi[i];
+        *has_declared = *has_declared && isfinite(declared[i]) && isfinite(declared[i + 3]) &&
+                        declared[i + 3] > declared[i];
+    }
+    return 0;
+}
+
+/* Splits the arguments of objects[i].texture.generate into argv (argv[0] the method),
+ * in buf. */
+static int split_args(Ctx *c, const char *q, const char *args, char *buf, size_t n, char **argv,
+                      int *argc)
+{
+    *argc = 0;
+    if (strlen(args) >= n - 1) return scene_fail(c, q, "too long");
+    snprintf(buf, n, "%s", args);
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, " \t\n", &save); tok; tok = strtok_r(NULL, " \t\n", &save)) {
+        if (*argc == 61) return scene_fail(c, q, "too many arguments");
+        if (!strcmp(tok, "-o") || !strcmp(tok, "--output"))
+            return scene_fail(c, q,
+                              "give the texgen arguments without -o: the scene chooses the file");
+        argv[(*argc)++] = tok;
+    }
+    argv[*argc] = NULL;
+    return 0;
+}
+
+/* Parses argv (bomb or deform) as `vbcl texgen` does and runs the generator into t. */
+static int run_texgen(Ctx *c, const char *q, int argc, char **argv, TexSet *t)
+{
+    char err[1024];
+    TexgenOpts o;
+    BombParams bp;
+    DeformParams dp;
+    int bomb = !strcmp(argv[0], "bomb");
+    int rc = bomb ? texgen_bomb_args(argc, argv, &bp, &o, err, sizeof err)
+                  : texgen_deform_args(argc, argv, &dp, &o, err, sizeof err);
+    if (!rc && o.help)
+        return scene_fail(c, q, "expected the options of vbcl texgen %s, not %s (docs/texgen.md)",
+                          argv[0], "--help");
+    if (!rc && !scene_texgen_enabled)
+        return scene_fail(c, q, "this program cannot generate textures");
+    if (!rc)
+        rc = bomb ? texgen_bomb(&bp, t, err, sizeof err) : texgen_deform(&dp, t, err, sizeof err);
+    if (rc) return scene_fail(c, q, "vbcl texgen %s: %s", argv[0], err);
+    return 0;
+}
+
+/* objects[i].texture.generate, the arguments of `vbcl texgen bomb|deform`, into tex and the
+ * block it declares. Generated textures are cached ($VBCL_CACHE_DIR/textures/HASH.ply, see
+ * cache.h): generating wood or marble (deform, with its exact disjointness check) takes
+ * about 0.5 s, reading the file back a few milliseconds, so a cache hit reads the file; a
+ * miss generates in memory, uses that, and writes the file for the next time (a cache that
+ * cannot be written only makes the next load slower). */
+static int generate_texture(Ctx *c, const char *q, const char *args, Mesh *tex, float declared[6],
+                            int *has_declared)
+{
+    char dir[4096], path[4200], buf[1024], *argv[64], err[512];
+    int argc;
     size_t w0 = strspn(args, " \t\n"), w1 = strcspn(args + w0, " \t\n");
     if ((w1 == 7 && !strncmp(args + w0, "fourier", 7)) ||
         (w1 == 7 && !strncmp(args + w0, "project", 7)))
-        return scene_fail(
-            c, q,
-            "texgen %.7s makes an image, a surface pattern, not a volume texture: give the "
-            "material a \"pattern\" {\"type\": \"%s\"} (docs/scene-format.md)",
-            args + w0, args[w0] == 'f' ? "fourier" : "projection");
+        return scene_fail(c, q,
+                          "texgen %.7s makes an image, a surface pattern, not a volume texture: "
+                          "give the material a \"pattern\" {\"type\": \"%s\"} "
+                          "(docs/scene-format.md)",
+                          args + w0, args[w0] == 'f' ? "fourier" : "projection");
     if (!(w1 == 4 && !strncmp(args + w0, "bomb", 4)) &&
         !(w1 == 6 && !strncmp(args + w0, "deform", 6)))
         return scene_fail(c, q,
                           "expected \"bomb ...\" or \"deform ...\" (the texgen methods that make "
                           "volume textures)");
-    uint64_t h = cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: ");
-    h = cache_hash(h, args);
-    *temporary = 0;
-    if (cache_dir("textures", dir, sizeof dir)) {
-        snprintf(path, n, "%s/%016llx.ply", dir, (unsigned long long)h);
-    } else {
-        snprintf(path, n, "/tmp/vbcl-texture-%ld-%016llx.ply", (long)getpid(),
-                 (unsigned long long)h);
-        *temporary = 1;
-    }
-    if (!*temporary && access(path, R_OK) == 0) return 0; /* generated before */
-    char buf[1024], *argv[66];
-    int argc = 0;
-    if (strlen(args) >= sizeof buf - 1) return scene_fail(c, q, "too long");
-    snprintf(buf, sizeof buf, "%s", args);
-    argv[argc++] = (char *)"texgen";
-    for (char *tok = strtok(buf, " \t\n"); tok; tok = strtok(NULL, " \t\n")) {
-        if (argc == 62) return scene_fail(c, q, "too many arguments");
-        if (!strcmp(tok, "-o") || !strcmp(tok, "--output"))
-            return scene_fail(c, q,
-                              "give the texgen arguments without -o: the scene chooses the file");
-        argv[argc++] = tok;
-    }
-    argv[argc++] = (char *)"-o";
-    argv[argc++] = path;
-    argv[argc] = NULL;
-    if (!scene_texgen) return scene_fail(c, q, "this program cannot generate textures");
-    int rc = scene_texgen(argc, argv, err, sizeof err);
-    if (rc) return scene_fail(c, q, "vbcl texgen %s", err);
-    return 0;
+    if (split_args(c, q, args, buf, sizeof buf, argv, &argc)) return -1;
+    uint64_t h = cache_hash(cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: "), args);
+    int cached = cache_dir("textures", dir, sizeof dir) != NULL;
+    if (cached) snprintf(path, sizeof path, "%s/%016llx.ply", dir, (unsigned long long)h);
+    if (cached && access(path, R_OK) == 0) /* generated before */
+        return load_texture_file(c, q, path, tex, declared, has_declared);
+    TexSet t;
+    if (run_texgen(c, q, argc, argv, &t)) return -1;
+    int rc = texset_to_mesh(c, q, &t, tex, declared, has_declared);
+    if (!rc && cached) texset_write(&t, path, err, sizeof err);
+    texset_free(&t);
+    return rc;
 }
 
 /* Loads objects[i].texture into tex, in the object's own space (before its transform). */
@@ -125,16 +194,16 @@ int scene_load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, ve
     const cJSON *f = cJSON_GetObjectItemCaseSensitive(t, "file");
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(t, "generate");
     char full[4096], merr[512];
-    const char *shown;
-    int temporary = 0;
+    const char *shown = "the generated texture";
+    float declared[6];
+    int has_declared = 0;
     if (f && g) return scene_fail(c, p, "give \"file\" or \"generate\", not both");
     if (g) {
         json_path_key(q, p, "generate");
         if (!cJSON_IsString(g) || !g->valuestring[0])
             return scene_fail(c, q,
                               "expected the arguments of vbcl texgen, such as \"bomb --count 30\"");
-        if (generate_texture(c, q, g->valuestring, full, sizeof full, &temporary)) return -1;
-        shown = "the generated texture";
+        if (generate_texture(c, q, g->valuestring, tex, declared, &has_declared)) return -1;
     } else {
         json_path_key(q, p, "file");
         if (!f)
@@ -144,13 +213,8 @@ int scene_load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, ve
             return scene_fail(c, q, "expected a file name, got %s", json_type_name(f));
         scene_join_path(full, sizeof full, s->dir, f->valuestring);
         shown = f->valuestring;
+        if (load_texture_file(c, q, full, tex, declared, &has_declared)) return -1;
     }
-    char head[8192];
-    int bad = mesh_load_head(full, tex, head, sizeof head, merr, sizeof merr);
-    float declared[6];
-    int has_declared = !bad && read_block_comment(head, declared);
-    if (temporary) remove(full);
-    if (bad) return scene_fail(c, q, "%s", merr);
     if (mesh_check_closed(tex, merr, sizeof merr))
         return scene_fail(c, q, "%s: texture elements must be closed and consistently oriented: %s",
                           shown, merr);
