@@ -297,7 +297,7 @@ int scene_load_frame(const char *path, int frame, Scene *s, char *err, size_t er
     return rc;
 }
 
-/* Everything inside the document root, for the frame anim_apply has set. */
+/* Everything inside the document root, for the frame scene_anim_apply has set. */
 static int load_document(Ctx *c, const cJSON *root, Scene *s)
 {
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");

@@ -45,7 +45,7 @@ int scene_load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
 }
 
 /* objects[i] with "shape": "revolution": a profile swept about the y axis (its triangle
- * count was checked before any shape was built: count_triangles_first). */
+ * count was checked before any shape was built: scene_count_triangles). */
 static int load_revolution(Ctx *c, const cJSON *o, const char *p, Mesh *m)
 {
     char q[PATH_MAX_LEN];
