@@ -554,7 +554,6 @@ static int check_scene(const Options *o, const char *text, int *first, int *last
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
-    scene_texgen = texgen_run_quiet;
     double t0 = clu_now_ms();
     Options o;
     int rc = parse_args(argc, argv, &o);

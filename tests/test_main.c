@@ -96,7 +96,6 @@ int main(int argc, char **argv)
             th_set_filter(argv[i]);
     }
     atexit(cleanup);
-    scene_texgen = texgen_run_quiet;
     suite_mesh();
     suite_grid_build();
     suite_scene();

@@ -91,11 +91,11 @@ typedef struct Scene {
                           VBCL_TAG_OPAQUE (an object that is not a host) */
 } Scene;
 
-/* The texture generator that objects[i].texture.generate runs (texgen_run_quiet):
- * set by the program; NULL makes "generate" an error. Kept as a hook so that the
- * scene parser links without the generator (the fuzzers). */
-typedef int (*SceneTexgenFn)(int argc, char **argv, char *err, size_t errlen);
-extern SceneTexgenFn scene_texgen;
+/* Whether objects[i].texture.generate runs the texture generators (texgen_bomb,
+ * texgen_deform): 1 unless a program turns it off. The scene fuzzer does, so that an input
+ * asking for a million elements cannot make a run slow: the arguments are still parsed and
+ * checked, and a valid "generate" is then an error. */
+extern int scene_texgen_enabled;
 
 /* Reads and checks a scene file. Returns 0, or 2 (bad input) with a one-line message in
  * err: "FILE:LINE:COL: ..." for JSON syntax, "FILE: json.path: what was expected" for

@@ -1,8 +1,8 @@
 /* texgen.c — the `vbcl texgen` command line: parses a method's options, runs the
- * generator and writes the mesh or preview image (exit 0 done, 2 bad input, 1 I/O). */
+ * generator and writes the mesh or preview image (exit 0 done, 2 bad input, 1 I/O); the
+ * options themselves are parsed in texgen_args.c. */
 #include "texgen.h"
 
-#include <errno.h>
 #include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
@@ -84,24 +84,14 @@ static const char usage_project[] =
     "its size; R(X,Y,Z) is the texel nearest to (X, Y) in [0,1]^2, 0 outside.\n"
     "  --image IMG         image to project (any format OpenImageIO reads)\n";
 
-/* While texgen_run_quiet runs: where messages go instead of stderr, and no reports. */
-static char *quiet_err;
-static size_t quiet_len;
-
-/* Reports "vbcl texgen[ METHOD]: message" (on stderr, or into the quiet buffer, keeping
- * the first) and returns status. */
+/* Reports "vbcl texgen[ METHOD]: message" on stderr and returns status. */
 static int report(int status, const char *method, const char *fmt, va_list ap)
 {
     char msg[768];
     diag_vformat(msg, sizeof msg, fmt, ap);
-    if (quiet_err) {
-        if (!quiet_err[0])
-            snprintf(quiet_err, quiet_len, "%s%s%s", method ? method : "", method ? ": " : "", msg);
-    } else {
-        char prefix[64];
-        snprintf(prefix, sizeof prefix, "vbcl texgen%s%s", method ? " " : "", method ? method : "");
-        diag_print(prefix, "%s", msg);
-    }
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "vbcl texgen%s%s", method ? " " : "", method ? method : "");
+    diag_print(prefix, "%s", msg);
     return status;
 }
 
@@ -127,73 +117,6 @@ static int fail_io(const char *method, const char *fmt, ...)
     return rc;
 }
 
-static int parse_int(const char *s, long lo, long hi, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) return -1;
-    *out = (int)v;
-    return 0;
-}
-
-static int parse_u64(const char *s, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    if (*s == '-') return -1;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (errno || end == s || *end) return -1;
-    *out = v;
-    return 0;
-}
-
-static int parse_float(const char *s, float *out)
-{
-    char *end;
-    errno = 0;
-    float v = strtof(s, &end);
-    if (errno || end == s || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-/* Comma-separated numbers; returns how many, or -1. */
-static int parse_list(const char *s, float *out, int max)
-{
-    int n = 0;
-    const char *p = s;
-    while (*p) {
-        char *end;
-        errno = 0;
-        float v = strtof(p, &end);
-        if (errno || end == p || !isfinite(v) || n == max) return -1;
-        out[n++] = v;
-        if (*end == ',' && end[1])
-            p = end + 1;
-        else if (*end == 0)
-            p = end;
-        else
-            return -1;
-    }
-    return n ? n : -1;
-}
-
-static int is_help(const char *a)
-{
-    return !strcmp(a, "--help") || !strcmp(a, "-h");
-}
-
-/* The value after option i, or NULL (with the message printed) when it is missing. */
-static const char *value(int argc, char **argv, int *i, const char *method)
-{
-    if (*i + 1 >= argc) {
-        fail(method, "%s needs a value", argv[*i]);
-        return NULL;
-    }
-    return argv[++*i];
-}
-
 static int has_ext(const char *path, const char *ext)
 {
     size_t n = strlen(path), k = strlen(ext);
@@ -215,7 +138,7 @@ static int write_texture(const char *method, TexSet *t, const char *out)
     int rc = texset_write(t, out, err, sizeof err);
     uint64_t ntris = 0;
     for (int e = 0; e < t->count; e++) ntris += t->elems[e].ntris;
-    if (rc == 0 && !quiet_err)
+    if (rc == 0)
         printf("%s: %d elements, %llu triangles\n", out, t->count, (unsigned long long)ntris);
     texset_free(t);
     if (rc == -2) return fail(method, "%s", err);
@@ -223,225 +146,63 @@ static int write_texture(const char *method, TexSet *t, const char *out)
     return 0;
 }
 
-#define BAD_VALUE(opt, v, what) fail(M, "%s %s: expected %s", opt, v, what)
+/* The status of a method's generator: -1 bad parameters (2), else I/O or memory (1). */
+static int generated(const char *method, int rc, const char *err)
+{
+    return rc == -1 ? fail(method, "%s", err) : fail_io(method, "%s", err);
+}
 
 static int cmd_bomb(int argc, char **argv)
 {
     static const char *M = "bomb";
     BombParams p;
-    bomb_defaults(&p);
-    const char *out = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (is_help(a)) {
-            fputs(usage_bomb, stdout);
-            return 0;
-        }
-        if (!strcmp(a, "--no-overlap")) {
-            p.no_overlap = 1;
-            continue;
-        }
-        if (a[0] != '-') return fail(M, "unexpected argument '%s'", a);
-        if (!(v = value(argc, argv, &i, M))) return 2;
-        if (!strcmp(a, "--shape")) {
-            if (!strcmp(v, "sphere"))
-                p.shape = TEX_SPHERE;
-            else if (!strcmp(v, "cylinder"))
-                p.shape = TEX_CYLINDER;
-            else if (!strcmp(v, "cube"))
-                p.shape = TEX_CUBE;
-            else
-                return BAD_VALUE(a, v, "sphere, cylinder or cube");
-        } else if (!strcmp(a, "--count")) {
-            if (parse_int(v, 1, 1000000, &p.count)) return BAD_VALUE(a, v, "1 to 1000000");
-        } else if (!strcmp(a, "--size")) {
-            const char *colon = strchr(v, ':');
-            char lo[64];
-            if (!colon || (size_t)(colon - v) >= sizeof lo) return BAD_VALUE(a, v, "MIN:MAX");
-            memcpy(lo, v, (size_t)(colon - v));
-            lo[colon - v] = 0;
-            if (parse_float(lo, &p.size_min) || parse_float(colon + 1, &p.size_max))
-                return BAD_VALUE(a, v, "MIN:MAX with two numbers");
-            if (!(p.size_min > 0) || p.size_min > p.size_max)
-                return BAD_VALUE(a, v, "0 < MIN <= MAX");
-        } else if (!strcmp(a, "--seed")) {
-            if (parse_u64(v, &p.seed)) return BAD_VALUE(a, v, "an integer >= 0");
-        } else if (!strcmp(a, "--block")) {
-            if (parse_float(v, &p.block) || !(p.block > 0)) return BAD_VALUE(a, v, "a size > 0");
-        } else if (!strcmp(a, "--level")) {
-            if (parse_int(v, 0, 5, &p.level)) return BAD_VALUE(a, v, "0 to 5");
-        } else if (!strcmp(a, "--segments")) {
-            if (parse_int(v, 3, 1024, &p.segments)) return BAD_VALUE(a, v, "3 to 1024");
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            out = v;
-        } else {
-            return fail(M, "unknown option %s (see vbcl texgen bomb --help)", a);
-        }
-    }
-    if (check_mesh_path(M, out)) return 2;
+    TexgenOpts o;
+    char err[1024];
+    if (texgen_bomb_args(argc, argv, &p, &o, err, sizeof err)) return fail(M, "%s", err);
+    if (o.help) return fputs(usage_bomb, stdout), 0;
+    if (check_mesh_path(M, o.output)) return 2;
     TexSet t;
-    char err[512];
     int rc = texgen_bomb(&p, &t, err, sizeof err);
-    if (rc == -1) return fail(M, "%s", err);
-    if (rc < 0) return fail_io(M, "%s", err);
-    return write_texture(M, &t, out);
-}
-
-/* --taper/--twist: a list, "random" or "none". */
-static int parse_values(const char *v, float *list, int *n, int *random)
-{
-    if (!strcmp(v, "random")) {
-        *random = 1;
-        *n = 0;
-        return 0;
-    }
-    *random = 0;
-    if (!strcmp(v, "none")) {
-        *n = 0;
-        return 0;
-    }
-    *n = parse_list(v, list, DEFORM_MAX);
-    return *n < 0 ? -1 : 0;
-}
-
-/* The number option a of `texgen deform` sets in p, or NULL. */
-static float *deform_float_field(DeformParams *p, const char *a)
-{
-    const struct {
-        const char *name;
-        float *field;
-    } opts[] = {{"--taper-max", &p->taper_max}, {"--twist-max", &p->twist_max},
-                {"--spacing", &p->spacing},     {"--aspect", &p->aspect},
-                {"--length", &p->length},       {"--tube-radius", &p->tube_radius},
-                {"--wobble", &p->wobble}};
-    for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++)
-        if (!strcmp(a, opts[i].name)) return opts[i].field;
-    return NULL;
+    if (rc < 0) return generated(M, rc, err);
+    return write_texture(M, &t, o.output);
 }
 
 static int cmd_deform(int argc, char **argv)
 {
     static const char *M = "deform";
     DeformParams p;
-    float *f;
-    deform_defaults(&p);
-    const char *out = NULL;
-    int taper_given = 0;
-    /* the preset first, so that other options override it wherever they stand */
-    for (int i = 1; i + 1 < argc; i++)
-        if (!strcmp(argv[i], "--preset") && deform_preset(&p, argv[i + 1]) < 0)
-            return BAD_VALUE("--preset", argv[i + 1], "figure2.2, wood or marble");
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (is_help(a)) {
-            fputs(usage_deform, stdout);
-            return 0;
-        }
-        if (a[0] != '-') return fail(M, "unexpected argument '%s'", a);
-        if (!(v = value(argc, argv, &i, M))) return 2;
-        if (!strcmp(a, "--preset")) {
-            continue;
-        } else if (!strcmp(a, "--profile")) {
-            if (!strcmp(v, "circle"))
-                p.rect = 0;
-            else if (!strcmp(v, "rect"))
-                p.rect = 1;
-            else
-                return BAD_VALUE(a, v, "circle or rect");
-        } else if (!strcmp(a, "--kind")) {
-            if (!strcmp(v, "nested"))
-                p.kind = DEFORM_NESTED;
-            else if (!strcmp(v, "tubes"))
-                p.kind = DEFORM_TUBES;
-            else
-                return BAD_VALUE(a, v, "nested or tubes");
-        } else if (!strcmp(a, "--count")) {
-            if (parse_int(v, 1, DEFORM_MAX, &p.count)) return BAD_VALUE(a, v, "1 to 64");
-        } else if (!strcmp(a, "--taper")) {
-            taper_given = 1;
-            if (parse_values(v, p.taper, &p.ntaper, &p.taper_random))
-                return BAD_VALUE(a, v, "A1,A2,... (one per profile), random or none");
-        } else if (!strcmp(a, "--twist")) {
-            if (parse_values(v, p.twist, &p.ntwist, &p.twist_random))
-                return BAD_VALUE(a, v, "T1,T2,... (one per profile), random or none");
-        } else if ((f = deform_float_field(&p, a))) {
-            if (parse_float(v, f)) return BAD_VALUE(a, v, "a number");
-        } else if (!strcmp(a, "--segments")) {
-            if (parse_int(v, 3, 4096, &p.segments)) return BAD_VALUE(a, v, "3 to 4096");
-        } else if (!strcmp(a, "--rings")) {
-            if (parse_int(v, 0, 4096, &p.rings)) return BAD_VALUE(a, v, "0 (auto) to 4096");
-        } else if (!strcmp(a, "--seed")) {
-            if (parse_u64(v, &p.seed)) return BAD_VALUE(a, v, "an integer >= 0");
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            out = v;
-        } else {
-            return fail(M, "unknown option %s (see vbcl texgen deform --help)", a);
-        }
-    }
-    if (p.ntaper && p.ntaper != p.count && !taper_given)
-        return fail(M,
-                    "--count %d: the default --taper has %d values (figure 2.2); expected "
-                    "--taper with %d values, --taper random or --taper none",
-                    p.count, p.ntaper, p.count);
-    if (check_mesh_path(M, out)) return 2;
-    TexSet t;
+    TexgenOpts o;
     char err[1024];
+    if (texgen_deform_args(argc, argv, &p, &o, err, sizeof err)) return fail(M, "%s", err);
+    if (o.help) return fputs(usage_deform, stdout), 0;
+    if (check_mesh_path(M, o.output)) return 2;
+    TexSet t;
     int rc = texgen_deform(&p, &t, err, sizeof err);
-    if (rc == -1) return fail(M, "%s", err);
-    if (rc < 0) {
-        return fail_io("deform", "%s", err);
-    }
-    return write_texture(M, &t, out);
+    if (rc < 0) return generated(M, rc, err);
+    return write_texture(M, &t, o.output);
 }
 
 static int cmd_fourier(int argc, char **argv)
 {
     static const char *M = "fourier";
-    int terms = 5, pixels = 256;
-    float a0 = 1.0f, freq[3] = {12.566371f, 12.566371f, 12.566371f}, z = 0.5f, extent = 1.0f;
-    uint64_t seed = 1;
-    const char *out = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (is_help(a)) {
-            fputs(usage_fourier, stdout);
-            return 0;
-        }
-        if (a[0] != '-') return fail(M, "unexpected argument '%s'", a);
-        if (!(v = value(argc, argv, &i, M))) return 2;
-        if (!strcmp(a, "--terms")) {
-            if (parse_int(v, 4, 7, &terms)) return BAD_VALUE(a, v, "4 to 7 (thesis 2.1.2)");
-        } else if (!strcmp(a, "--contrast")) {
-            if (parse_float(v, &a0) || !(a0 >= 0)) return BAD_VALUE(a, v, "A_0 >= 0");
-        } else if (!strcmp(a, "--freq")) {
-            int n = parse_list(v, freq, 3);
-            if (n == 1) freq[1] = freq[2] = freq[0];
-            if (n != 1 && n != 3) return BAD_VALUE(a, v, "F or FX,FY,FZ");
-        } else if (!strcmp(a, "--seed")) {
-            if (parse_u64(v, &seed)) return BAD_VALUE(a, v, "an integer >= 0");
-        } else if (!strcmp(a, "--z")) {
-            if (parse_float(v, &z)) return BAD_VALUE(a, v, "a number");
-        } else if (!strcmp(a, "--extent")) {
-            if (parse_float(v, &extent) || !(extent > 0)) return BAD_VALUE(a, v, "a size > 0");
-        } else if (!strcmp(a, "--pixels")) {
-            if (parse_int(v, 1, 8192, &pixels)) return BAD_VALUE(a, v, "1 to 8192");
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            out = v;
-        } else {
-            return fail(M, "unknown option %s (see vbcl texgen fourier --help)", a);
-        }
-    }
-    char err[512];
+    FourierArgs a;
+    TexgenOpts o;
+    char err[1024];
+    if (texgen_fourier_args(argc, argv, &a, &o, err, sizeof err)) return fail(M, "%s", err);
+    if (o.help) return fputs(usage_fourier, stdout), 0;
+    const char *out = o.output;
+    int pixels = a.pixels;
     if (!out) return fail(M, "missing -o FILE (expected an image path: .png .jpg .tif .exr)");
     if (image_check_path(out, err, sizeof err)) return fail(M, "%s", err);
     VbFourier f;
-    if (texgen_fourier_init(&f, terms, a0, freq, seed, err, sizeof err)) return fail(M, "%s", err);
+    if (texgen_fourier_init(&f, a.terms, a.a0, a.freq, a.seed, err, sizeof err))
+        return fail(M, "%s", err);
     float *rgba = malloc((size_t)pixels * (size_t)pixels * 4 * sizeof *rgba);
     if (!rgba) return fail_io(M, "out of memory for a %d x %d image", pixels, pixels);
     for (int y = 0; y < pixels; y++)
         for (int x = 0; x < pixels; x++) {
-            float X = extent * (x + 0.5f) / pixels, Y = extent * (pixels - y - 0.5f) / pixels;
-            float g = solidtex_fourier_eval(&f, X, Y, z);
+            float X = a.extent * (x + 0.5f) / pixels, Y = a.extent * (pixels - y - 0.5f) / pixels;
+            float g = solidtex_fourier_eval(&f, X, Y, a.z);
             g = g < 0.0f ? 0.0f : g;
             float *px = &rgba[4 * ((size_t)y * pixels + x)];
             px[0] = px[1] = px[2] = g;
@@ -450,46 +211,25 @@ static int cmd_fourier(int argc, char **argv)
     int rc = image_write(out, pixels, pixels, rgba, 0.0f, err, sizeof err);
     free(rgba);
     if (rc) return fail_io(M, "%s", err);
-    printf("%s: G(X, Y, %g) on [0, %g]^2, %d terms, C_1 = %.6g, A_0 = %g\n", out, z, extent, terms,
-           f.c[0], a0);
+    printf("%s: G(X, Y, %g) on [0, %g]^2, %d terms, C_1 = %.6g, A_0 = %g\n", out, a.z, a.extent,
+           a.terms, f.c[0], a.a0);
     return 0;
 }
 
 static int cmd_project(int argc, char **argv)
 {
     static const char *M = "project";
-    const char *image = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (is_help(a)) {
-            fputs(usage_project, stdout);
-            return 0;
-        }
-        if (a[0] != '-') return fail(M, "unexpected argument '%s'", a);
-        if (!(v = value(argc, argv, &i, M))) return 2;
-        if (!strcmp(a, "--image"))
-            image = v;
-        else
-            return fail(M, "unknown option %s (see vbcl texgen project --help)", a);
-    }
-    if (!image) return fail(M, "missing --image IMG");
+    TexgenOpts o;
+    char err[1024];
+    if (texgen_project_args(argc, argv, &o, err, sizeof err)) return fail(M, "%s", err);
+    if (o.help) return fputs(usage_project, stdout), 0;
+    if (!o.image) return fail(M, "missing --image IMG");
     int w, h;
     float *rgba;
-    char err[512];
-    if (texgen_projection_load(image, &w, &h, &rgba, err, sizeof err)) return fail(M, "%s", err);
+    if (texgen_projection_load(o.image, &w, &h, &rgba, err, sizeof err)) return fail(M, "%s", err);
     free(rgba);
-    printf("%s: %d x %d texels, projected along Z over [0,1]^2\n", image, w, h);
+    printf("%s: %d x %d texels, projected along Z over [0,1]^2\n", o.image, w, h);
     return 0;
-}
-
-int texgen_run_quiet(int argc, char **argv, char *err, size_t errlen)
-{
-    err[0] = 0;
-    quiet_err = err;
-    quiet_len = errlen;
-    int rc = texgen_main(argc, argv);
-    quiet_err = NULL;
-    return rc;
 }
 
 int texgen_main(int argc, char **argv)
@@ -498,7 +238,7 @@ int texgen_main(int argc, char **argv)
         return fail(NULL, "expected a method: bomb, deform, fourier or project (see vbcl texgen "
                           "--help)");
     const char *m = argv[1];
-    if (is_help(m)) {
+    if (texgen_is_help(m)) {
         fputs(usage_main, stdout);
         return 0;
     }

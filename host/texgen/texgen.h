@@ -124,15 +124,40 @@ int texgen_fourier_init(VbFourier *f, int n, float a0, const float base_freq[3],
 int texgen_projection_load(const char *path, int *width, int *height, float **rgba, char *err,
                            size_t errlen);
 
+/* ---- a method's options: the command line's, and a scene's inline "generate" ---- */
+
+/* What the options say besides the parameters. */
+typedef struct TexgenOpts {
+    const char *output; /* -o FILE, or NULL */
+    const char *image;  /* project: --image IMG, or NULL */
+    int help;           /* --help or -h came: parsing stopped there */
+} TexgenOpts;
+
+/* `texgen fourier`'s options: G's parameters and the preview slice. */
+typedef struct FourierArgs {
+    int terms, pixels;
+    float a0, freq[3], z, extent;
+    uint64_t seed;
+} FourierArgs;
+
+/* Whether arg asks for help: "--help" or "-h". */
+int texgen_is_help(const char *arg);
+
+/* Parse the options of `vbcl texgen METHOD` (argv[0] is the method's name) into the
+ * method's parameters, starting from its defaults (bomb_defaults, deform_defaults, and
+ * a preset first when --preset is given). Return 0, or -1 with what was expected in err,
+ * without the method's name ("--count 0: expected 1 to 1000000"). */
+int texgen_bomb_args(int argc, char **argv, BombParams *p, TexgenOpts *o, char *err, size_t errlen);
+int texgen_deform_args(int argc, char **argv, DeformParams *p, TexgenOpts *o, char *err,
+                       size_t errlen);
+int texgen_fourier_args(int argc, char **argv, FourierArgs *f, TexgenOpts *o, char *err,
+                        size_t errlen);
+int texgen_project_args(int argc, char **argv, TexgenOpts *o, char *err, size_t errlen);
+
 /* ---- command line ---- */
 
 /* `vbcl texgen METHOD [options]`; argv[0] is "texgen". Returns the exit status: 0 done,
  * 2 bad parameters or usage (one line on stderr), 1 I/O failure. */
 int texgen_main(int argc, char **argv);
-
-/* texgen_main without output: a message for a non-zero status goes into err
- * ("METHOD: what was expected"), and nothing is printed. For scenes that generate their
- * textures inline. */
-int texgen_run_quiet(int argc, char **argv, char *err, size_t errlen);
 
 #endif
