@@ -108,5 +108,6 @@ int main(int argc, char **argv)
     suite_render();
     suite_aa();
     suite_dispersion();
+    suite_structure();
     return th_summary();
 }

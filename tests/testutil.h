@@ -36,5 +36,6 @@ void suite_stability(void);
 void suite_render(void);
 void suite_aa(void);
 void suite_dispersion(void);
+void suite_structure(void);
 
 #endif
