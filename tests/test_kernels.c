@@ -18,6 +18,27 @@ static void trace_grid(Fixture *fx, cl_mem rays, int n, cl_mem hits, cl_mem coun
     fixture_run_frame_kernel(fx, "scene_intersect_closest", rays, n, hits, counters);
 }
 
+/* The closest hits of n rays through the grid (hg) and by brute force (hb). */
+static void trace_grid_and_brute(Fixture *fx, const VbRay *rays, int n, VbHit *hg, VbHit *hb)
+{
+    cl_mem mr = buffer(rays, sizeof *rays * (size_t)n);
+    cl_mem mg = buffer(NULL, sizeof *hg * (size_t)n), mb = buffer(NULL, sizeof *hb * (size_t)n);
+    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_mem mc = buffer(zero, sizeof zero);
+    trace_grid(fx, mr, n, mg, mc);
+    cl_uint ntris = fx->s.mesh.ntris;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
+                         sizeof(cl_mem)};
+    const void *v[] = {&fx->r.buf.tris, &ntris, &mr, &n, &mb};
+    run_kernel(fx->r.program, "probe_intersect_brute", (size_t)n, 5, sz, v);
+    read_buffer(mg, hg, sizeof *hg * (size_t)n);
+    read_buffer(mb, hb, sizeof *hb * (size_t)n);
+    clReleaseMemObject(mr);
+    clReleaseMemObject(mg);
+    clReleaseMemObject(mb);
+    clReleaseMemObject(mc);
+}
+
 static void test_kernel_struct_layout(void)
 {
     Fixture fx;
@@ -92,18 +113,7 @@ static void compare_grid_brute(const char *label, const char *json, const char *
     VbRay *rays = malloc(sizeof *rays * (size_t)n);
     VbHit *hg = malloc(sizeof *hg * (size_t)n), *hb = malloc(sizeof *hb * (size_t)n);
     random_rays(&fx.s, rays, n, 12345u);
-    cl_mem mr = buffer(rays, sizeof *rays * (size_t)n);
-    cl_mem mg = buffer(NULL, sizeof *hg * (size_t)n), mb = buffer(NULL, sizeof *hb * (size_t)n);
-    cl_uint zero[VBCL_COUNTERS] = {0};
-    cl_mem mc = buffer(zero, sizeof zero);
-    trace_grid(&fx, mr, n, mg, mc);
-    cl_uint ntris = fx.s.mesh.ntris;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
-                         sizeof(cl_mem)};
-    const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &n, &mb};
-    run_kernel(fx.r.program, "probe_intersect_brute", (size_t)n, 5, sz, v);
-    read_buffer(mg, hg, sizeof *hg * (size_t)n);
-    read_buffer(mb, hb, sizeof *hb * (size_t)n);
+    trace_grid_and_brute(&fx, rays, n, hg, hb);
     int hits = 0, ties = 0, bad = 0;
     for (int i = 0; i < n; i++) {
         hits += hb[i].tri >= 0;
@@ -127,10 +137,6 @@ static void compare_grid_brute(const char *label, const char *json, const char *
             label, grid, fx.r.grid.n[0], fx.r.grid.n[1], fx.r.grid.n[2], n, hits, ties, bad);
     CHECK(hits > n / 10, "%s: enough rays hit (%d of %d)", label, hits, n);
     CHECK(ties < n / 1000 + 5, "%s: ties are rare (%d)", label, ties);
-    clReleaseMemObject(mr);
-    clReleaseMemObject(mg);
-    clReleaseMemObject(mb);
-    clReleaseMemObject(mc);
     free(rays);
     free(hg);
     free(hb);
@@ -193,19 +199,7 @@ static void test_contact_opaque_surface_first(void)
             rays[i] =
                 (VbRay){{x, 0.1f + 0.8f * frand(&seed), z}, INFINITY, {d.x, d.y, d.z}, (cl_uint)i};
         }
-        cl_mem mr = buffer(rays, sizeof *rays * N);
-        cl_mem mg = buffer(NULL, sizeof *hg * N), mb = buffer(NULL, sizeof *hb * N);
-        cl_uint zero[VBCL_COUNTERS] = {0};
-        cl_mem mc = buffer(zero, sizeof zero);
-        trace_grid(&fx, mr, N, mg, mc);
-        cl_uint ntris = fx.s.mesh.ntris;
-        int n = N;
-        const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
-                             sizeof(cl_mem)};
-        const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &n, &mb};
-        run_kernel(fx.r.program, "probe_intersect_brute", N, 5, sz, v);
-        read_buffer(mg, hg, sizeof *hg * N);
-        read_buffer(mb, hb, sizeof *hb * N);
+        trace_grid_and_brute(&fx, rays, N, hg, hb);
         int floor_g = 0, floor_b = 0;
         for (int i = 0; i < N; i++) {
             floor_g += hg[i].tri >= 0 && (fx.s.tri_tag[hg[i].tri] & ~VBCL_TAG_FLAGS) == 0;
@@ -218,10 +212,6 @@ static void test_contact_opaque_surface_first(void)
         CHECK(floor_g == N && floor_b == N,
               "grid %s: the floor in contact must come first: grid %d, brute force %d of %d",
               grids[g], floor_g, floor_b, N);
-        clReleaseMemObject(mr);
-        clReleaseMemObject(mg);
-        clReleaseMemObject(mb);
-        clReleaseMemObject(mc);
         free(rays);
         free(hg);
         free(hb);
