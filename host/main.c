@@ -394,27 +394,37 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
     return 0;
 }
 
-/* Renders frame `frame` of the scene (-1: a scene that is not animated; text: the scene
- * file, read once) on dev, writes it and reports it (report_frame; *json: the --stats-json
- * document); t0 is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, const char *text, int frame, VbDevice *dev, double t0,
-                        cJSON **json)
+/* Loads frame `frame` of the scene (-1: a scene that is not animated; text: the scene
+ * file, read once) with the command line applied. Returns 0 or an exit status after a
+ * message; on 0 the caller frees *s. */
+static int load_frame(const Options *o, const char *text, int frame, Scene *s)
 {
     char err[1024] = "";
-    Scene s;
-    if (scene_load_text(o->scene, text, frame, &s, err, sizeof err)) {
+    if (scene_load_text(o->scene, text, frame, s, err, sizeof err)) {
         diag_print("vbcl", "%s", err);
         return 2;
     }
-    int rc = apply_options(o, &s);
-    char *out = rc ? NULL : output_path(o, &s, frame);
-    char *map = (rc || !o->aa_map) ? NULL : frame_path(o->aa_map, frame);
+    int rc = apply_options(o, s);
+    if (rc) scene_free(s);
+    return rc;
+}
+
+/* Renders frame `frame` of the loaded scene *scene (its command line applied; freed here)
+ * on dev, writes it and reports it (report_frame; *json: the --stats-json document); t0
+ * is when this frame's work began. Returns an exit status. */
+static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev, double t0,
+                        cJSON **json)
+{
+    char err[1024] = "";
+    Scene s = *scene;
+    int rc = 0;
+    char *out = output_path(o, &s, frame);
+    char *map = !o->aa_map ? NULL : frame_path(o->aa_map, frame);
     float *rgba = NULL;
     Frame fr;
     memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (rc) goto done_scene;
     if (!out || (o->aa_map && !map)) {
         fprintf(stderr, "vbcl: out of memory\n");
         rc = 1;
@@ -505,32 +515,24 @@ static int check_outputs(const Options *o, const Scene *s, int first, int last)
 static int check_frames(const Options *o, const char *text, int first, int last)
 {
     for (int f = first; f <= last; f++) {
-        char err[1024];
         Scene s;
-        if (scene_load_text(o->scene, text, f, &s, err, sizeof err)) {
-            diag_print("vbcl", "%s", err);
-            return 2;
-        }
-        int rc = apply_options(o, &s);
-        scene_free(&s);
+        int rc = load_frame(o, text, f, &s);
         if (rc) return rc;
+        scene_free(&s);
     }
     return 0;
 }
 
 /* The scene as written, then --frames against its frame count, every frame to render and
  * every output path. Sets the frames to render (first = last = -1: a still image). Returns
- * 0 or an exit status. */
-static int check_scene(const Options *o, const char *text, int *first, int *last)
+ * 0 or an exit status; on 0 with a still image, *still holds the checked scene, loaded
+ * once for checking and rendering (the caller frees it). */
+static int check_scene(const Options *o, const char *text, int *first, int *last, Scene *still)
 {
-    char err[1024] = "";
     Scene s;
-    if (scene_load_text(o->scene, text, -1, &s, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
-        return 2;
-    }
+    int rc = load_frame(o, text, -1, &s);
+    if (rc) return rc;
     int frames = s.frames, animated = s.animated;
-    int rc = apply_options(o, &s);
     *first = animated ? 0 : -1;
     *last = animated ? frames - 1 : -1;
     if (!rc && o->frame_first >= 0) {
@@ -546,8 +548,12 @@ static int check_scene(const Options *o, const char *text, int *first, int *last
     }
     if (!rc) rc = check_outputs(o, &s, *first, *last);
     if (!rc && o->stats_json) rc = check_output_dir(o->stats_json);
+    if (!rc && !animated) {
+        *still = s;
+        return 0;
+    }
     scene_free(&s);
-    if (!rc && animated) rc = check_frames(o, text, *first, *last);
+    if (!rc) rc = check_frames(o, text, *first, *last);
     return rc;
 }
 
@@ -563,12 +569,14 @@ int main(int argc, char **argv)
     /* the scene, read once (it may be a pipe), checked as written and in every frame to be
      * rendered, and every output path, before any device is opened */
     char err[1024] = "", *text = NULL;
-    int first, last;
+    int first = -1, last = -2;
     if (scene_read_text(o.scene, &text, err, sizeof err)) {
         diag_print("vbcl", "%s", err);
         return 2;
     }
-    rc = check_scene(&o, text, &first, &last);
+    Scene still;
+    rc = check_scene(&o, text, &first, &last, &still);
+    int have_still = !rc && first < 0; /* still is ours to render or free */
     VbDevice dev = {0};
     int opened = 0;
     if (!rc) {
@@ -578,8 +586,14 @@ int main(int argc, char **argv)
         opened = !rc;
     }
     cJSON *json = NULL; /* the --stats-json document */
+    if (rc && have_still) scene_free(&still);
     for (int f = first; !rc && f <= last; f++) {
-        rc = render_frame(&o, text, f, &dev, t0, &json);
+        Scene s;
+        if (f < 0)
+            s = still;
+        else if ((rc = load_frame(&o, text, f, &s)))
+            break;
+        rc = render_frame(&o, &s, f, &dev, t0, &json);
         t0 = clu_now_ms();
     }
     cJSON_Delete(json);

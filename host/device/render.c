@@ -37,15 +37,14 @@ int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nra
     return 0;
 }
 
-int renderer_fit_local_size(Renderer *r, cl_kernel k)
+/* Lowers r->local_size to 0 unless kernel k runs work-groups of that size. */
+static void renderer_fit_local_size(Renderer *r, cl_kernel k)
 {
     size_t max = 0;
-    if (!k) return 0;
     if (clGetKernelWorkGroupInfo(k, r->dev->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof max, &max,
                                  NULL) != CL_SUCCESS ||
         max < r->local_size)
         r->local_size = 0;
-    return 0;
 }
 
 const size_t *renderer_local(const Renderer *r, size_t global)

@@ -99,9 +99,6 @@ int renderer_set_frame_args(const Renderer *r, cl_kernel k, cl_mem rays, int nra
  * with the error recorded (clu_error). */
 int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms);
 
-/* Lowers r->local_size to 0 unless kernel k runs work-groups of that size. Returns 0. */
-int renderer_fit_local_size(Renderer *r, cl_kernel k);
-
 /* The local size argument of clEnqueueNDRangeKernel for the global size `global`. */
 const size_t *renderer_local(const Renderer *r, size_t global);
 

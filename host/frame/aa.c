@@ -143,8 +143,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
     VbAaPass pass;
     pass_init(&pass, s);
     pass.write_level = 1;
-    free(aa->levels_host);
-    aa->levels_host = malloc(sizeof(int) * npix);
+    aa->levels_host = malloc(sizeof(int) * npix); /* frame_render freed the last frame's */
     if (!aa->levels_host) {
         snprintf(err, errlen, "out of memory");
         return 1;
