@@ -37,14 +37,16 @@ static const char *const kind_names[KIND_COUNT] = {"primary", "shadow", "shadow_
 
 /* One ray kind: the rays both sides trace, and what they measured. */
 typedef struct Kind {
-    VbRay *rays;         /* what Embree traces (the feelers, for the shadow kinds) */
-    size_t nrays;        /* rays of this kind */
-    uint32_t *steps;     /* shadow_glass: the renderer's closest-hit calls per feeler */
-    float *vbcl_out;     /* vbcl's answer per ray: distance (-1 miss), or 1/0 blocked */
-    uint32_t *points;    /* shadow kinds: the primary rays whose hits vbcl shades */
-    size_t npoints;      /* shadow kinds: how many */
-    cl_mem in, out, aux; /* vbcl: rays or points; hits or traced counts; radiance */
+    VbRay *rays;             /* what Embree traces (the feelers, for the shadow kinds) */
+    size_t nrays;            /* rays of this kind */
+    uint32_t *steps;         /* shadow_glass: the renderer's closest-hit calls per feeler */
+    float *vbcl_out;         /* vbcl's answer per ray: distance (-1 miss), or 1/0 blocked */
+    uint32_t *points;        /* shadow kinds: the primary rays whose hits vbcl shades */
+    size_t npoints;          /* shadow kinds: how many */
+    cl_mem in, out, aux;     /* vbcl: rays or points; hits or traced counts; radiance */
+    cl_mem feelers, blocked; /* shadow: its feelers for probe_trace_any, and the answers */
     double vbcl_ms[MAX_REPEATS], embree_ms[MAX_REPEATS];
+    double any_ms[MAX_REPEATS]; /* shadow: scene_trace_any alone on the same feelers */
     size_t agree, compared;
     unsigned long long calls; /* closest-hit calls of the shadow_glass walks */
 } Kind;
@@ -423,6 +425,7 @@ static int split_feelers(Bench *b, const uint32_t *points, const FeelerSet *fs)
         jsh += in_sh;
         for (uint32_t k = fs->offsets[j]; k < fs->offsets[j + 1]; k++) {
             if (in_sh) {
+                sh->vbcl_out[ish] = fs->end[k] >= 0.0f ? 1.0f : 0.0f; /* the walk's answer */
                 sh->rays[ish++] = fs->rays[k];
                 continue;
             }
@@ -432,6 +435,10 @@ static int split_feelers(Bench *b, const uint32_t *points, const FeelerSet *fs)
             gl->calls += fs->steps[k];
         }
     }
+    sh->feelers = clu_buffer(&b->dev, sh->nrays ? sh->rays : NULL, sizeof(VbRay) * sh->nrays,
+                             CL_MEM_READ_ONLY);
+    sh->blocked = clu_buffer(&b->dev, NULL, sh->nrays, CL_MEM_READ_WRITE);
+    if (!sh->feelers || !sh->blocked) goto done;
     rc = shadow_kind_buffers(b, sh, psh, nsh) || shadow_kind_buffers(b, gl, pgl, ngl) ? -1 : 0;
 done:
     free(psh);
@@ -541,34 +548,34 @@ static double embree_time(Bench *b, int k, float *out)
     return bench_embree_trace(b->emb, op, kd->rays, kd->nrays, kd->steps, out, NULL, b->o.threads);
 }
 
-/* vbcl's answers for the agreement check, where the timed runs did not leave them on the
- * host: the closest kinds' hits, and for "shadow" probe_trace_any on its feelers. */
+/* The shadow kind's feelers by scene_trace_any alone (probe_trace_any), into kd->blocked. */
+static int vbcl_any_time(Bench *b, Kind *kd, double *ms)
+{
+    int n = (int)kd->nrays;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *vals[] = {&kd->feelers, &n, &kd->blocked};
+    return probe_args(b, b->k_any, 3, sz, vals) || probe_run(b, b->k_any, kd->nrays, ms) ? -1 : 0;
+}
+
+/* vbcl's answers for the agreement check, where the timed runs left them on the device: the
+ * closest kinds' hits; for "shadow" the renderer's walk (export_feelers) where
+ * probe_trace_any agrees with it, else 2, which agrees with nothing (shadow_glass: the walk). */
 static int vbcl_answers(Bench *b, int k)
 {
     Kind *kd = &b->kinds[k];
-    if (k == KIND_PRIMARY || k == KIND_SECONDARY) {
-        VbHit *h = malloc(sizeof(VbHit) * (kd->nrays + 1));
-        int rc = h ? read_buf(b, kd->out, h, sizeof(VbHit) * kd->nrays) : -1;
+    if (k == KIND_GLASS) return 0;
+    if (k == KIND_SHADOW) {
+        unsigned char *h = malloc(kd->nrays + 1);
+        int rc = h ? read_buf(b, kd->blocked, h, kd->nrays) : -1;
         for (size_t i = 0; !rc && i < kd->nrays; i++)
-            kd->vbcl_out[i] = h[i].tri < 0 ? -1.0f : h[i].t;
+            if ((h[i] != 0) != (kd->vbcl_out[i] > 0.0f)) kd->vbcl_out[i] = 2.0f;
         free(h);
         return rc;
     }
-    if (k != KIND_SHADOW) return 0; /* shadow_glass: the walk's ends, from export_feelers */
-    cl_mem rays = clu_buffer(&b->dev, kd->rays, sizeof(VbRay) * kd->nrays, CL_MEM_READ_ONLY);
-    cl_mem blocked = clu_buffer(&b->dev, NULL, kd->nrays, CL_MEM_READ_WRITE);
-    unsigned char *h = malloc(kd->nrays + 1);
-    int n = (int)kd->nrays, rc = -1;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *vals[] = {&rays, &n, &blocked};
-    if (rays && blocked && h && !probe_args(b, b->k_any, 3, sz, vals) &&
-        !probe_run(b, b->k_any, kd->nrays, NULL) && !read_buf(b, blocked, h, kd->nrays)) {
-        for (size_t i = 0; i < kd->nrays; i++) kd->vbcl_out[i] = h[i] ? 1.0f : 0.0f;
-        rc = 0;
-    }
+    VbHit *h = malloc(sizeof(VbHit) * (kd->nrays + 1));
+    int rc = h ? read_buf(b, kd->out, h, sizeof(VbHit) * kd->nrays) : -1;
+    for (size_t i = 0; !rc && i < kd->nrays; i++) kd->vbcl_out[i] = h[i].tri < 0 ? -1.0f : h[i].t;
     free(h);
-    if (rays) clReleaseMemObject(rays);
-    if (blocked) clReleaseMemObject(blocked);
     return rc;
 }
 
@@ -595,6 +602,8 @@ static int measure(Bench *b)
             if (kd->nrays == 0) continue;
             if (vbcl_time(b, k, &ms)) goto done;
             if (rep >= 0) kd->vbcl_ms[rep] = ms;
+            if (k == KIND_SHADOW && vbcl_any_time(b, kd, &ms)) goto done;
+            if (k == KIND_SHADOW && rep >= 0) kd->any_ms[rep] = ms;
             if (b->emb) ms = embree_time(b, k, out[k]);
             if (rep >= 0) kd->embree_ms[rep] = ms;
         }
@@ -635,14 +644,19 @@ static double mrays(const Kind *kd, const double *ms, int n)
     return kd->nrays && m > 0.0 ? (double)kd->nrays / (m * 1e3) : 0.0;
 }
 
+/* The grid as asked for: --grid's value, else "scene" (the scene's own) or "auto". */
+static const char *grid_label(const Bench *b)
+{
+    return b->o.grid ? b->o.grid : b->s.grid_res[0] > 0 ? "scene" : "auto";
+}
+
 static void report_text(const Bench *b)
 {
     const Grid *g = &b->r.grid;
     printf("%s: %u triangles, grid %s (%dx%dx%d), %dx%d camera rays, %u feelers per point "
            "and light; vbcl on %s; %s, %d threads%s; median of %d\n",
-           b->s.path, b->s.mesh.ntris, b->o.grid ? b->o.grid : "as the scene says", g->n[0],
-           g->n[1], g->n[2], b->s.width, b->s.height,
-           b->r.frame_host.shadow_strata * b->r.frame_host.shadow_strata, b->dev.name,
+           b->s.path, b->s.mesh.ntris, grid_label(b), g->n[0], g->n[1], g->n[2], b->s.width,
+           b->s.height, b->r.frame_host.shadow_strata * b->r.frame_host.shadow_strata, b->dev.name,
            bench_embree_describe(), b->o.threads,
            b->emb ? (b->o.robust ? ", robust" : ", not robust") : "", b->o.repeats);
     printf("%-13s %10s %12s %12s %9s %10s\n", "kind", "rays", "vbcl Mray/s", "Embree Mray/s",
@@ -657,6 +671,13 @@ static void report_text(const Bench *b)
         else
             printf("%12s %9s %10s\n", "-", "-", "-");
     }
+    const Kind *sh = &b->kinds[KIND_SHADOW];
+    if (sh->nrays) {
+        double a = mrays(sh, sh->any_ms, b->o.repeats), e = mrays(sh, sh->embree_ms, b->o.repeats);
+        printf("shadow: scene_trace_any alone on the same feelers %.3f Mray/s", a);
+        if (b->emb) printf(", %.3f of Embree", e > 0 ? a / e : 0.0);
+        printf("\n");
+    }
     if (b->kinds[KIND_GLASS].nrays)
         printf("shadow_glass: %.2f closest-hit calls per feeler\n",
                (double)b->kinds[KIND_GLASS].calls / (double)b->kinds[KIND_GLASS].nrays);
@@ -670,6 +691,8 @@ static void report_json_kinds(const Bench *b, FILE *f)
         fprintf(f, "%s    {\"kind\": \"%s\", \"rays\": %zu, \"vbcl_mrays_s\": %.6g", k ? ",\n" : "",
                 kind_names[k], kd->nrays, v);
         if (k == KIND_SHADOW || k == KIND_GLASS) fprintf(f, ", \"points\": %zu", kd->npoints);
+        if (k == KIND_SHADOW)
+            fprintf(f, ", \"vbcl_any_mrays_s\": %.6g", mrays(kd, kd->any_ms, b->o.repeats));
         if (k == KIND_GLASS && kd->nrays)
             fprintf(f, ", \"calls_per_ray\": %.4f", (double)kd->calls / (double)kd->nrays);
         if (b->emb && kd->nrays)
@@ -707,8 +730,7 @@ static int report_json(const Bench *b)
     }
     const Grid *g = &b->r.grid;
     const char *keys[] = {"scene", "grid", "device", "embree"};
-    const char *vals[] = {b->s.path, b->o.grid ? b->o.grid : "scene", b->dev.name,
-                          bench_embree_describe()};
+    const char *vals[] = {b->s.path, grid_label(b), b->dev.name, bench_embree_describe()};
     for (int i = 0; i < 4; i++) {
         fprintf(f, "%s\"%s\": ", i ? ", " : "{", keys[i]);
         json_string(f, vals[i]);
@@ -796,8 +818,8 @@ static void bench_close(Bench *b)
         free(kd->rays);
         free(kd->steps);
         free(kd->vbcl_out);
-        cl_mem m[] = {kd->in, kd->out, kd->aux};
-        for (int i = 0; i < 3; i++)
+        cl_mem m[] = {kd->in, kd->out, kd->aux, kd->feelers, kd->blocked};
+        for (int i = 0; i < 5; i++)
             if (m[i]) clReleaseMemObject(m[i]);
     }
     cl_kernel ks[] = {b->k_closest, b->k_any,  b->k_surface,  b->k_shade,
