@@ -384,6 +384,8 @@ def part_embree(a, out):
                     "vbcl_mrays_s": f"{k['vbcl_mrays_s']:.3f}" if k["rays"] else "",
                     "embree_mrays_s": f"{k['embree_mrays_s']:.3f}" if emb else "",
                     "vbcl/embree": f"{k['ratio']:.3f}" if emb else "",
+                    "vbcl_any_mrays_s": (f"{k['vbcl_any_mrays_s']:.3f}"
+                                         if "vbcl_any_mrays_s" in k and k["rays"] else ""),
                     "agreement": f"{100 * k['agreement']:.3f}%" if emb else "",
                 })
     note = (f"{size}x{size} camera rays, the scenes' feelers per point"
@@ -396,11 +398,13 @@ def part_embree(a, out):
             "light_shade_local against rtcOccluded1); shadow_glass (the other opaque primary hits' "
             "feelers: light_shade_local against as many rtcIntersect1 from crossing to crossing as "
             "the renderer's walk makes); secondary (reflected and transmitted rays from primary "
-            "hits on dielectrics, closest hit). agreement: rays on which both sides agree on "
-            "hit or miss and the distance (1e-4 relative).")
+            "hits on dielectrics, closest hit). vbcl_any: the shadow feelers by scene_trace_any "
+            "alone. agreement: rays on which both sides agree on hit or miss and the distance "
+            "(1e-4 relative).")
     return write_table(out, "embree", rows,
                        ["scene", "triangles", "grid", "cells", "kind", "rays", "vbcl_mrays_s",
-                        "embree_mrays_s", "vbcl/embree", "agreement"], title, note)
+                        "embree_mrays_s", "vbcl/embree", "vbcl_any_mrays_s", "agreement"],
+                       title, note)
 
 
 def machine(vbcl):
