@@ -1,7 +1,8 @@
 #line 2 "probe.cl"
-/* probe.cl — kernels for the tests only (built with -DVBCL_TEST_KERNELS): brute-force
- * closest hit, the layout of the shared structs as the device sees it, and local
- * shading at arbitrary points for analytic checks. */
+/* probe.cl — kernels for the tests and the ray-throughput bench only (built with
+ * -DVBCL_TEST_KERNELS, never in a render): brute-force closest hit, the layout of the shared
+ * structs as the device sees it, local shading at arbitrary points for analytic checks, and
+ * the renderer's tracing and shading on rays the bench picks (tests/bench/bench_rays.c). */
 #ifndef VBCL_PROBE_CL
 #define VBCL_PROBE_CL
 
