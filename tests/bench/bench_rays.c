@@ -776,6 +776,16 @@ static int bench_open(Bench *b)
 {
     char err[1024];
     const Options *o = &b->o;
+    if (o->json) { /* the output must be writable before any work */
+        snprintf(err, sizeof err, "%s.tmp", o->json);
+        FILE *f = fopen(err, "w");
+        if (!f) {
+            fprintf(stderr, "vbcl-bench-rays: --json %s: cannot write there\n", o->json);
+            return 2;
+        }
+        fclose(f);
+        remove(err);
+    }
     if (scene_load(o->scene, &b->s, err, sizeof err)) {
         fprintf(stderr, "vbcl-bench-rays: %s\n", err);
         return 2;
