@@ -339,7 +339,7 @@ static int export_feelers(Bench *b, Kind *kd, FeelerSet *fs)
     unsigned long long total;
     int rc = -1, np = (int)kd->npoints, nr;
     cl_mem offsets = NULL, feelers = NULL, written = NULL, steps = NULL, end = NULL;
-    uint32_t *counts = malloc(sizeof(uint32_t) * (kd->npoints + 1));
+    uint32_t *counts = malloc(sizeof(uint32_t) * (kd->npoints + 1)), *got = NULL;
     fs->npoints = kd->npoints;
     fs->offsets = malloc(sizeof(uint32_t) * (kd->npoints + 1));
     if (!counts || !fs->offsets || shade_points(b, kd, NULL, &total)) goto done;
@@ -367,8 +367,8 @@ static int export_feelers(Bench *b, Kind *kd, FeelerSet *fs)
     const void *va[] = {&b->rays, &b->hits, &b->media, &kd->in, &np, &offsets, &feelers, &written};
     if (probe_args(b, b->k_feelers, 8, sz, va) || probe_run(b, b->k_feelers, kd->npoints, NULL))
         goto done;
-    uint32_t *got = (uint32_t *)fs->steps; /* scratch until the walk fills it */
-    if (read_buf(b, written, got, sizeof(uint32_t) * kd->npoints)) goto done;
+    got = malloc(sizeof(uint32_t) * (kd->npoints + 1));
+    if (!got || read_buf(b, written, got, sizeof(uint32_t) * kd->npoints)) goto done;
     for (size_t j = 0; j < kd->npoints; j++)
         if (got[j] != counts[j]) {
             fprintf(stderr,
@@ -389,6 +389,7 @@ static int export_feelers(Bench *b, Kind *kd, FeelerSet *fs)
     rc = 0;
 done:
     free(counts);
+    free(got);
     cl_mem all[] = {offsets, feelers, written, steps, end};
     for (int i = 0; i < 5; i++)
         if (all[i]) clReleaseMemObject(all[i]);
@@ -654,7 +655,7 @@ static void report_text(const Bench *b)
 {
     const Grid *g = &b->r.grid;
     printf("%s: %u triangles, grid %s (%dx%dx%d), %dx%d camera rays, %u feelers per point "
-           "and light; vbcl on %s; %s, %d threads%s; median of %d\n",
+           "and spherical light; vbcl on %s; %s, %d threads%s; median of %d\n",
            b->s.path, b->s.mesh.ntris, grid_label(b), g->n[0], g->n[1], g->n[2], b->s.width,
            b->s.height, b->r.frame_host.shadow_strata * b->r.frame_host.shadow_strata, b->dev.name,
            bench_embree_describe(), b->o.threads,
