@@ -119,8 +119,8 @@ endif
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
 # figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
-# band counts, kernel build time. CSV, markdown and PNG in bench-out/. BENCH_FLAGS passes
-# options, e.g. BENCH_FLAGS="--parts grid --size 200".
+# band counts, kernel build time, rays per second against Embree. CSV, markdown and PNG in
+# bench-out/. BENCH_FLAGS passes options, e.g. BENCH_FLAGS="--parts grid --size 200".
 BENCH_FLAGS ?=
 # Embree, for the part "embree", is installed here (install-deps.sh --bench); where it cannot
 # be, that part measures vbcl alone.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""bench.py — `make bench`: the thesis's own measurements and ours, in four parts.
+"""bench.py — `make bench`: the thesis's own measurements and ours, in five parts.
 
   1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
               threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
