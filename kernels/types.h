@@ -188,7 +188,8 @@ typedef struct VbAaPass {
     float floor;          /* contrast: a + b below this counts as this (dark noise) */
     unsigned int first;   /* batch: its first entry in the list of marked nodes (or pixels) */
     unsigned int entries; /* batch: entries in it */
-    unsigned int pad[3];
+    unsigned int confirm; /* contrast: a failing pair of leaves must fail again one level up */
+    unsigned int pad[2];
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */
