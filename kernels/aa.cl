@@ -43,51 +43,28 @@ VB_INLINE float4 aa_leaf_at(__constant const VbAaPass *aa, __global const float 
                   tree);
 }
 
-/* The area mean (display value) of the node of s x s cells that holds image cell (X, Y):
- * the refined value of a node whose children are leaves or deeper. */
-VB_INLINE float3 aa_node_mean(__constant const VbAaPass *aa, __global const float *film,
-                              __global const int *slots, __global const float *tree, int X, int Y,
-                              int s)
-{
-    int X0 = X / s * s, Y0 = Y / s * s;
-    float3 sum = (float3)(0.0f);
-    for (int y = Y0; y < Y0 + s; y++)
-        for (int x = X0; x < X0 + s; x++) sum += aa_leaf_at(aa, film, slots, tree, x, y).xyz;
-    return aa_display(aa, sum * (1.0f / (float)(s * s)));
-}
-
 /* Whether the leaf of s x s cells at (X0, Y0) (image cells), level lv, display value a,
  * fails the contrast test against an adjacent leaf at its level or deeper: the ring of
  * cells around it is walked one adjacent leaf at a time (leaves are aligned squares, so
  * the next leaf along a row starts at the next multiple of the current one's size). An
- * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2).
- * With aa->confirm, a failing pair below level 0 must fail again one level up, between
- * the refined values (area means) of the leaf's parent and of the node of the parent's
- * size holding the neighbour — the thesis's while loop, which compares the reconstructed
- * pixel again: a difference that is noise averages out there, an edge does not. */
+ * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2). */
 VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float *film,
                             __global const int *slots, __global const float *tree, int X0, int Y0,
                             int s, int lv, float3 a)
 {
-    int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE, have_parent = 0;
-    float3 pa = a;
+    int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE;
     for (int side = 0; side < 4; side++) {
         int row = side < 2; /* sides 0, 1: the rows above and below, corners included */
         int fixed = row ? (side == 0 ? Y0 - 1 : Y0 + s) : (side == 2 ? X0 - 1 : X0 + s);
         if (fixed < 0 || fixed >= (row ? H : W)) continue;
         int lo = row ? max(X0 - 1, 0) : Y0, hi = row ? min(X0 + s, W - 1) : Y0 + s - 1;
         for (int t = lo; t <= hi;) {
-            int X = row ? t : fixed, Y = row ? fixed : t;
-            float4 c = aa_leaf_at(aa, film, slots, tree, X, Y);
+            float4 c = row ? aa_leaf_at(aa, film, slots, tree, t, fixed)
+                           : aa_leaf_at(aa, film, slots, tree, fixed, t);
             int lc = (int)c.w, sc = AA_TREE_SIDE >> lc;
+            if (lc >= lv && aa_contrast_fails(a, aa_display(aa, c.xyz), aa->threshold, aa->floor))
+                return 1;
             t = (t / sc + 1) * sc;
-            if (lc < lv || !aa_contrast_fails(a, aa_display(aa, c.xyz), aa->threshold, aa->floor))
-                continue;
-            if (!aa->confirm || lv == 0) return 1;
-            if (!have_parent) pa = aa_node_mean(aa, film, slots, tree, X0, Y0, 2 * s);
-            have_parent = 1;
-            float3 pb = aa_node_mean(aa, film, slots, tree, X, Y, 2 * s);
-            if (aa_contrast_fails(pa, pb, aa->threshold, aa->floor)) return 1;
         }
     }
     return 0;

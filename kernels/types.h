@@ -188,8 +188,7 @@ typedef struct VbAaPass {
     float floor;          /* contrast: a + b below this counts as this (dark noise) */
     unsigned int first;   /* batch: its first entry in the list of marked nodes (or pixels) */
     unsigned int entries; /* batch: entries in it */
-    unsigned int confirm; /* contrast: a failing pair of leaves must fail again one level up */
-    unsigned int pad[2];
+    unsigned int pad[3];
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */

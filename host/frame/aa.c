@@ -272,8 +272,6 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     memset(pass, 0, sizeof *pass);
     pass->threshold = s->aa_threshold;
     pass->floor = s->aa_floor;
-    const char *cf = getenv("VBCL_AA_CONFIRM"); /* EXPERIMENT */
-    pass->confirm = cf && cf[0] == '1';
     pass->contrast_scale = exp2f(s->exposure);
     pass->max_level = s->aa_max_level;
     pass->width = s->width;
