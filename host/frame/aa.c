@@ -159,8 +159,8 @@ static void aa_progress(AaProgress *pg, int round, int level, unsigned long long
     if (!pg->on || (el < 1000.0 && !pg->shown)) return;
     double eta = done > 0 ? rel * (total - done) / done : 0.0;
     fprintf(stderr,
-            "\rvbcl: anti-aliasing round %d (to level %d) %3.0f%%, %llu samples (%.1f per "
-            "pixel), %.1f s, about %.1f s left in the round ",
+            "\rvbcl: anti-aliasing round %d, level %d: %3.0f%%, %llu samples (%.1f/pixel), "
+            "%.1f s, round done in about %.1f s ",
             round + 1, level, 100.0 * done / total, samples, (double)samples / (double)npix,
             el / 1000.0, eta / 1000.0);
     pg->shown = 1;
