@@ -70,6 +70,41 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
     return 0;
 }
 
+/* Whether pixel p (x, y) needs its contrast test this round: in round 0 every pixel, later
+ * only a pixel that was split last round or has a neighbour that was (changed[] holds the
+ * round of each pixel's last split, or -1). A leaf's test reads only its own pixel and
+ * its 8 neighbours, so a pixel none of them changed gives last round's answer again:
+ * nothing (its marked leaves were split, which changed it). */
+VB_INLINE int aa_pixel_dirty(__constant const VbAaPass *aa, __global const int *changed, int x,
+                             int y)
+{
+    if (aa->round == 0) return 1;
+    for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
+        for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++)
+            if (changed[qy * aa->width + qx] == aa->round - 1) return 1;
+    return 0;
+}
+
+/* Whether an unsplit pixel p (x, y), display value a, whose 8 neighbours are all unsplit
+ * too fails against one of them: the plain 8-neighbour test of the thesis, all at level 0
+ * (the ring walk of aa_leaf_fails gives the same answer, one neighbour at a time). */
+VB_INLINE int aa_plain_pixel_fails(__constant const VbAaPass *aa, __global const float *film,
+                                   __global const int *slots, int x, int y, float3 a,
+                                   int *all_plain)
+{
+    int fails = 0;
+    *all_plain = 1;
+    for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
+        for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++) {
+            int q = qy * aa->width + qx;
+            if (q == y * aa->width + x) continue;
+            if (slots[q] >= 0) *all_plain = 0;
+            fails |=
+                aa_contrast_fails(a, aa_display(aa, vload4(q, film).xyz), aa->threshold, aa->floor);
+        }
+    return fails;
+}
+
 /* The position of finest cell `cell` in its pixel, in pixels from the pixel's corner: the
  * cell's centre, except the centre cell whose sample is the pixel centre (pass 0's). */
 VB_INLINE float2 aa_cell_position(int cell)

@@ -343,24 +343,38 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float
     vstore4(sum * (1.0f / (float)n), aa->first + j, film);
 }
 
-/* film, slots, tree -> marks, counts: over the whole image, every leaf below the top level
- * against its adjacent leaves (aa_leaf_fails); a failing leaf is appended to marks as
- * (pixel, node code). counts[0] counts the marks, counts[1 + l] those at level l. */
+/* film, slots, tree, changed -> marks, counts: over the whole image, every leaf below the
+ * top level against its adjacent leaves (aa_leaf_fails), in pixels whose neighbourhood
+ * changed last round; a failing leaf is appended to marks as (pixel, node code). counts[0]
+ * counts the marks, counts[1 + l] those at level l. */
 __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
                                __global const int *slots, __global const float *tree,
-                               __global uint2 *marks, __global uint *counts)
+                               __global uint2 *marks, __global uint *counts,
+                               __global const int *changed)
 {
     int p = get_global_id(0);
     if (p >= aa->width * aa->height) return;
-    int X = (p % aa->width) * AA_TREE_SIDE, Y = (p / aa->width) * AA_TREE_SIDE;
-    int slot = slots[p];
-    for (int k = 0; k < (slot < 0 ? 1 : VBCL_AA_CELLS); k++) {
-        float4 c = slot < 0 ? (float4)(vload4(p, film).xyz, 0.0f)
-                            : vload4((size_t)slot * VBCL_AA_CELLS + (size_t)k, tree);
+    int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
+    if (!aa_pixel_dirty(aa, changed, x, y)) return;
+    if (slot < 0) {
+        float3 a = aa_display(aa, vload4(p, film).xyz);
+        int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
+        if (all_plain ? !fails
+                      : !aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE, y * AA_TREE_SIDE,
+                                       AA_TREE_SIDE, 0, a))
+            return;
+        uint m = atomic_inc(&counts[0]);
+        atomic_inc(&counts[1]);
+        marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
+        return;
+    }
+    for (int k = 0; k < VBCL_AA_CELLS; k++) {
+        float4 c = vload4((size_t)slot * VBCL_AA_CELLS + (size_t)k, tree);
         int lv = (int)c.w, s = AA_TREE_SIDE >> lv;
         int fx = k % AA_TREE_SIDE, fy = k / AA_TREE_SIDE;
         if (lv >= aa->max_level || fx % s || fy % s) continue; /* not a leaf's first cell */
-        if (!aa_leaf_fails(aa, film, slots, tree, X + fx, Y + fy, s, lv, aa_display(aa, c.xyz)))
+        if (!aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE + fx, y * AA_TREE_SIDE + fy, s,
+                           lv, aa_display(aa, c.xyz)))
             continue;
         uint m = atomic_inc(&counts[0]);
         atomic_inc(&counts[1 + lv]);
@@ -385,19 +399,21 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
                          aa_sample_id(m.x, AA_TREE_SIDE, (uint)cell));
 }
 
-/* radiance, marks -> tree, slots, slot_pixels: each marked node of a batch becomes four
- * leaves one level deeper: the child holding the node's sample keeps its value, the other
- * three take the new samples. A pixel split for the first time gets a tree slot
- * (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them). */
+/* radiance, marks -> tree, slots, slot_pixels, changed: each marked node of a batch becomes
+ * four leaves one level deeper: the child holding the node's sample keeps its value, the
+ * other three take the new samples. A pixel split for the first time gets a tree slot
+ * (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them); every
+ * split pixel records the round in changed. */
 __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2 *marks,
                              __global const float *radiance, __global const float *film,
                              __global int *slots, __global int *slot_pixels, __global float *tree,
-                             __global uint *counts)
+                             __global uint *counts, __global int *changed)
 {
     uint j = get_global_id(0);
     if (j >= aa->entries) return;
     uint2 m = marks[aa->first + j];
     int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
+    changed[m.x] = aa->round;
     if (slot < 0) {
         slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
         slots[m.x] = slot;

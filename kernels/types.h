@@ -188,7 +188,8 @@ typedef struct VbAaPass {
     float floor;          /* contrast: a + b below this counts as this (dark noise) */
     unsigned int first;   /* batch: its first entry in the list of marked nodes (or pixels) */
     unsigned int entries; /* batch: entries in it */
-    unsigned int pad[3];
+    int round;            /* adaptive: the round (0, 1, ...) of this contrast pass or batch */
+    unsigned int pad[2];
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */

@@ -134,7 +134,7 @@ def cost_per_sample(st, plain):
         n = st["samples"]["total"]
         ms = st["time_ms"]["kernels"]
         rays = traced(st)
-    if n <= 0:
+    if n <= 0 or rays <= 0:
         return "", ""
     return f"{1000.0 * ms / n:.2f}", f"{1000.0 * ms / rays:.3f}"
 
@@ -178,7 +178,8 @@ def bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats)
     # work-group size, which is fixed), then the reference
     for opts in (["--aa", "0.1"], ["--ssaa", "2"]):
         render(a.vbcl, scene, 8, extra, opts, os.path.join(tmp, "warm.exr"))
-    plain = render(a.vbcl, scene, size, extra, [], os.path.join(tmp, "warm.exr"), full=True)
+    plain = render(a.vbcl, scene, size, extra, ["--aa", "0"], os.path.join(tmp, "warm.exr"),
+                   full=True)
     ref_scene = reseeded(scene)
     try:
         ref_ms, _ = render(a.vbcl, ref_scene, size, extra, ["--ssaa", "16"], ref_path)
@@ -186,7 +187,9 @@ def bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats)
         os.remove(ref_scene)
     ref = np.clip(read_exr(ref_path), 0.0, 1.0)
     settings = [("adaptive", t, ["--aa", str(t)]) for t in thresholds]
-    settings += [("uniform", n, ["--ssaa", str(n)]) for n in uniform]
+    # --ssaa 1 is the plain render; "--aa 0" also for scenes with their own render.aa
+    settings += [("uniform", n, ["--ssaa", str(n)] + (["--aa", "0"] if n == 1 else []))
+                 for n in uniform]
     rows = []
     for method, param, opts in settings:
         out = os.path.join(tmp, "img.exr")

@@ -361,7 +361,7 @@ static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, u
     }
 }
 
-static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc)
+static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const int changed[2])
 {
     static float tree[2 * VBCL_AA_CELLS * 4];
     float film[8] = {0};
@@ -376,13 +376,15 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc)
     pass.max_level = VBCL_AA_MAX_LEVEL;
     pass.width = 2;
     pass.height = 1;
-    cl_mem m[6] = {buffer(&pass, sizeof pass),  buffer(film, sizeof film),
-                   buffer(slots, sizeof slots), buffer(tree, sizeof tree),
-                   buffer(marks, sizeof marks), buffer(counts, sizeof counts)};
-    const size_t sz[6] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+    pass.round = round;
+    cl_mem m[7] = {buffer(&pass, sizeof pass),      buffer(film, sizeof film),
+                   buffer(slots, sizeof slots),     buffer(tree, sizeof tree),
+                   buffer(marks, sizeof marks),     buffer(counts, sizeof counts),
+                   buffer(changed, 2 * sizeof(int))};
+    const size_t sz[7] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
                           sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem)};
-    const void *v[6] = {&m[0], &m[1], &m[2], &m[3], &m[4], &m[5]};
-    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 6, sz, v) == 0) {
+    const void *v[7] = {&m[0], &m[1], &m[2], &m[3], &m[4], &m[5], &m[6]};
+    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 7, sz, v) == 0) {
         read_buffer(m[4], marks, sizeof marks);
         read_buffer(m[5], counts, sizeof counts);
         int missing = 0;
@@ -392,10 +394,11 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc)
                 found += (marks[2 * k] << 16 | marks[2 * k + 1]) == tc->want[w];
             missing += found != 1;
         }
-        CHECK(counts[0] == tc->nwant && missing == 0, "%s: %u marks, %u expected, %d missing",
-              tc->what, counts[0], tc->nwant, missing);
+        CHECK(counts[0] == tc->nwant && missing == 0,
+              "%s, round %d: %u marks, %u expected, %d missing", tc->what, round, counts[0],
+              tc->nwant, missing);
     }
-    for (int i = 0; i < 6; i++) clReleaseMemObject(m[i]);
+    for (int i = 0; i < 7; i++) clReleaseMemObject(m[i]);
 }
 
 #define P0(l, x, y) (0u << 16 | ((l) << 8 | (y) << 4 | (x)))
@@ -404,7 +407,10 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc)
 /* The quadtree's neighbour rule across levels and across the pixel border, on the
  * contrast kernel itself with two refined pixels side by side: a leaf is compared with
  * each adjacent leaf of its neighbour at the finer level of the two (8-neighbourhood, so
- * corners count), and of a failing pair the leaf at the lower level splits, both on a tie. */
+ * corners count), and of a failing pair the leaf at the lower level splits, both on a tie.
+ * After round 0 only pixels whose neighbourhood was split in the last round are tested:
+ * the same cases in round 1 mark the same leaves when pixel 1 was split in round 0, and
+ * nothing when the last split was earlier. */
 static void test_aa_neighbour_rule_across_levels(void)
 {
     Fixture fx;
@@ -458,7 +464,14 @@ static void test_aa_neighbour_rule_across_levels(void)
         /* below the threshold nothing splits */
         {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0},
     };
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) two_pixel_run(&fx, &cases[i]);
+    const int fresh[2] = {-1, 0}, stale[2] = {-1, -1};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        two_pixel_run(&fx, &cases[i], 0, stale);
+        two_pixel_run(&fx, &cases[i], 1, fresh);
+        TwoPixelCase none = cases[i];
+        none.nwant = 0;
+        two_pixel_run(&fx, &none, 2, fresh);
+    }
     fixture_close(&fx);
 }
 

@@ -33,7 +33,8 @@ static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t 
     aa->slots = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->info = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->counts = clu_buffer(d, NULL, sizeof(cl_uint) * AA_COUNTS, CL_MEM_READ_WRITE);
-    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts) return 0;
+    aa->changed = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->changed) return 0;
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
 }
@@ -133,8 +134,9 @@ static int aa_mark(AaState *aa, Renderer *r, const Scene *s, const VbAaPass *pas
     CL_CHECK(
         clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL, NULL),
         fail);
-    const cl_mem args[6] = {aa->pass, aa->film, aa->slots, aa->tree, aa->marks, aa->counts};
-    if (aa_launch(r, r->k_aa_contrast, 0, args, 6, (size_t)s->width * (size_t)s->height,
+    const cl_mem args[7] = {aa->pass,  aa->film,   aa->slots,  aa->tree,
+                            aa->marks, aa->counts, aa->changed};
+    if (aa_launch(r, r->k_aa_contrast, 0, args, 7, (size_t)s->width * (size_t)s->height,
                   &st->aa_contrast_ms))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
@@ -179,8 +181,9 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
         if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
         const cl_mem args[7] = {aa->pass,  aa->marks,       r->radiance, aa->film,
                                 aa->slots, aa->slot_pixels, aa->tree};
-        const cl_mem cnt = aa->counts;
-        if (clu_set_arg(r->k_aa_split_store, 7, sizeof(cl_mem), &cnt) ||
+        const cl_mem more[2] = {aa->counts, aa->changed};
+        if (clu_set_arg(r->k_aa_split_store, 7, sizeof(cl_mem), &more[0]) ||
+            clu_set_arg(r->k_aa_split_store, 8, sizeof(cl_mem), &more[1]) ||
             aa_launch(r, r->k_aa_split_store, 0, args, 7, k, &st->aa_reconstruct_ms))
             return -1;
         st->samples += 3ull * k;
@@ -258,6 +261,9 @@ static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba,
     CL_CHECK(clEnqueueFillBuffer(d->queue, aa->info, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
                                  0, NULL, NULL),
              fail);
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->changed, &none, sizeof none, 0,
+                                 sizeof(cl_int) * npix, 0, NULL, NULL),
+             fail);
     CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
                                   NULL),
              fail);
@@ -306,6 +312,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
                         err, errlen);
         if (rc) goto out;
         rc = 1;
+        pass.round = round;
         if (aa_mark(aa, r, s, &pass, counts, st)) goto fail;
         if (counts[0] == 0) break;
         st->aa_rounds++;
@@ -374,8 +381,8 @@ fail:
 
 void aa_release(AaState *aa)
 {
-    cl_mem *mems[] = {&aa->pass,   &aa->film, &aa->slots,       &aa->info,
-                      &aa->counts, &aa->tree, &aa->slot_pixels, &aa->marks};
+    cl_mem *mems[] = {&aa->pass, &aa->film,        &aa->slots, &aa->info,   &aa->counts,
+                      &aa->tree, &aa->slot_pixels, &aa->marks, &aa->changed};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);

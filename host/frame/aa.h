@@ -15,6 +15,7 @@
  * pixel, grown as pixels are refined), the list of marked nodes and the counters. */
 typedef struct AaState {
     cl_mem pass, film, slots, info, counts;
+    cl_mem changed;           /* each pixel's last round of splits, or -1 */
     cl_mem tree, slot_pixels; /* tree_cap slots */
     cl_mem marks;             /* mark_cap entries of (pixel, node code) */
     size_t tree_cap, slot_pixels_cap, mark_cap;
