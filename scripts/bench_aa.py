@@ -229,7 +229,8 @@ def plot(rows, scenes, path):
                 txt = fmt.format(r["param"], r["param"]) if method == "uniform" else fmt.format(r["param"])
                 ax.annotate(txt, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ref_ms = next(r["reference_ms"] for r in rows if r["scene"] == name)
-        ax.set_title(f"{label}, {size}x{size}\nreference 16x16: {ref_ms / 1000:.1f} s", fontsize=9)
+        ref_txt = f"\nreference 16x16: {ref_ms / 1000:.1f} s" if ref_ms else ""
+        ax.set_title(f"{label}, {size}x{size}{ref_txt}", fontsize=9)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("render time (s)")
