@@ -246,9 +246,14 @@ static void test_aa_options(void)
         CHECK(rmse(&key, &cli) == 0.0, "render.aa differs from --aa: %g", rmse(&key, &cli));
         free(key.px);
     }
-    const char *bad[] = {
-        "--aa 1.5",       "--aa-max-level 5",       "--ssaa 17", "--ssaa 0", "--aa 0.1 --ssaa 4",
-        "--aa-map m.png", "--aa 0.1 --aa-map m.bmp"};
+    const char *bad[] = {"--aa 1.5",
+                         "--aa-max-level 5",
+                         "--ssaa 17",
+                         "--ssaa 0",
+                         "--aa 0.1 --ssaa 4",
+                         "--aa-map m.png",
+                         "--aa 0.1 --aa-map m.bmp",
+                         "--aa 0.1 --aa-floor 3"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(cmd, sizeof cmd, "%s %s -q -o %s/never.png %s", tu_vbcl, AA_SCENE, tu_tmpdir(),
                  bad[i]);
@@ -346,6 +351,7 @@ typedef struct TwoPixelCase {
     float v0, v1, v_odd;
     unsigned odd[4], nodd;
     unsigned want[12], nwant;
+    float floor; /* the contrast's floor on a + b (0: the thesis's plain ratio) */
 } TwoPixelCase;
 
 static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, unsigned nodd,
@@ -372,6 +378,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
     VbAaPass pass;
     memset(&pass, 0, sizeof pass);
     pass.threshold = 0.1f;
+    pass.floor = tc->floor;
     pass.contrast_scale = 1.0f;
     pass.max_level = VBCL_AA_MAX_LEVEL;
     pass.width = 2;
@@ -421,7 +428,7 @@ static void test_aa_neighbour_rule_across_levels(void)
     const TwoPixelCase cases[] = {
         /* pixel 1 finer and brighter everywhere: only pixel 0's two leaves along the
          * border split; pixel 1's leaves see a coarser neighbour and wait */
-        {"finer neighbour", 1, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {P0(1, 1, 0), P0(1, 1, 1)}, 2},
+        {"finer neighbour", 1, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {P0(1, 1, 0), P0(1, 1, 1)}, 2, 0.0f},
         /* one bright level-2 leaf of pixel 1 at the bottom of the border: pixel 0's
          * lower-right leaf splits (pixel 1's other border leaves equal it), its
          * upper-right one does not; inside pixel 1 the bright leaf and its three
@@ -435,7 +442,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P1(2, 0, 3) & 0xffff},
          1,
          {P0(1, 1, 1), P1(2, 0, 3), P1(2, 0, 2), P1(2, 1, 2), P1(2, 1, 3)},
-         5},
+         5,
+         0.0f},
         /* a bright leaf higher up, (0, 1) (cells y 4..7): pixel 0's upper-right leaf
          * (y 0..7) meets it along the border, the lower-right one (y 8..15) only through
          * its corner cell (16, 7): both split */
@@ -449,7 +457,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          1,
          {P0(1, 1, 0), P0(1, 1, 1), P1(2, 0, 1), P1(2, 0, 0), P1(2, 1, 0), P1(2, 1, 1), P1(2, 1, 2),
           P1(2, 0, 2)},
-         8},
+         8,
+         0.0f},
         /* equal levels: both sides of the border split */
         {"tie",
          1,
@@ -460,9 +469,24 @@ static void test_aa_neighbour_rule_across_levels(void)
          {0},
          0,
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
-         4},
+         4,
+         0.0f},
+        /* a dark pair: relative contrast 0.33 splits both sides; with a floor of 0.5 on
+         * a + b the difference 0.01 is under 0.1 * 0.5 and nothing splits */
+        {"dark pair",
+         1,
+         1,
+         0.01f,
+         0.02f,
+         0.02f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
+         4,
+         0.0f},
+        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f},
         /* below the threshold nothing splits */
-        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0},
+        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f},
     };
     const int fresh[2] = {-1, 0}, stale[2] = {-1, -1};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
