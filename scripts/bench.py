@@ -294,7 +294,7 @@ def part_error(a, out):
         aa_rows = list(csv.DictReader(f))
     aa_text = write_table(out, "aa_time_error", aa_rows,
                           ["scene", "size", "method", "param", "render_ms",
-                           "samples_per_pixel", "rmse", "psnr_db"],
+                           "samples_per_pixel", "rmse", "psnr_db", "us_per_sample", "us_per_ray"],
                           "Run time against error: anti-aliasing",
                           "Against `--ssaa 16` of the same scene with another seed "
                           "(scripts/bench_aa.py).")
