@@ -39,7 +39,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz
+.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz test-drivers
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -146,6 +146,13 @@ oclgrind: $(BUILD)/vbcl
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_aa.json "$(OCLGRIND_FLAGS)"
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_dispersion.json "$(OCLGRIND_FLAGS)" 1e-3
+
+# A second OpenCL driver (docs/testing.md, "Two OpenCL drivers"): Intel's CPU runtime from
+# PyPI, installed once into ~/.cache/vbcl/intel-ocl (scripts/intel-ocl.sh), beside PoCL; the
+# same small scenes rendered on both and compared with stated tolerances.
+test-drivers: $(BUILD)/vbcl
+	$(Q)env=$$(scripts/intel-ocl.sh) && . "$$env" && \
+	    scripts/drivers_check.py --vbcl $(BUILD)/vbcl --a Portable --b Intel
 
 # libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
 # run from the seed corpus in tests/fuzz/corpus/ (docs/testing.md): FUZZ_RUNS executions
