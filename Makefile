@@ -29,7 +29,7 @@ CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) -MMD -MP
 CFLAGS   := $(CSTD) $(OPT) $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -Wshadow $(SANFLAGS)
 LDFLAGS  := $(SANFLAGS)
-LDLIBS   := $(PKG_LIBS) -lm
+LDLIBS   := $(PKG_LIBS) -lm -pthread
 
 HOST_C   := $(wildcard host/*.c host/*/*.c)
 HOST_CXX := $(wildcard host/*.cpp host/*/*.cpp)

@@ -56,7 +56,9 @@ static const char usage_text[] =
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
-    "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
+    "      --device INDEX|NAME|all|LIST  OpenCL device (also VBCL_DEVICE; default: device 0);\n"
+    "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
+    "                           tiles among several (refinement runs on the first)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
     "      --stats-json FILE    write the same statistics as JSON (fields: docs/stats.md);\n"
@@ -386,9 +388,14 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
     if (!o->quiet) {
         unsigned long long rays = stats_rays_total(fr->st);
         double render_ms = fr->st->render_ms;
+        char on[300];
+        if (fr->nwork > 1)
+            snprintf(on, sizeof on, "%d devices (--stats: each one's share)", fr->nwork);
+        else
+            snprintf(on, sizeof on, "%s", fr->dev->name);
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s->width, s->height, fr->total_ms / 1000.0, s->mesh.ntris, rays,
-               render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, fr->dev->name);
+               render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, on);
         fflush(stdout);
     }
     return 0;
@@ -412,8 +419,8 @@ static int load_frame(const Options *o, const char *text, int frame, Scene *s)
 /* Renders frame `frame` of the loaded scene *scene (its command line applied; freed here)
  * on dev, writes it and reports it (report_frame; *json: the --stats-json document); t0
  * is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev, double t0,
-                        cJSON **json)
+static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *devs, int ndev,
+                        double t0, cJSON **json)
 {
     char err[1024] = "";
     Scene s = *scene;
@@ -436,7 +443,7 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
         rc = 1;
         goto done_scene;
     }
-    rc = frame_init(&fr, dev, &s, &st, err, sizeof err);
+    rc = frame_init(&fr, devs, ndev, &s, &st, err, sizeof err);
     if (rc) {
         diag_print("vbcl", "%s", err);
         goto done_renderer;
@@ -458,7 +465,8 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
         rc = 1;
         goto done_renderer;
     }
-    StatsFrame sf = {&s, dev, &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0};
+    StatsFrame sf = {&s,      &devs[0], &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0,
+                     fr.work, ndev};
     rc = report_frame(o, &sf, out, json);
 done_renderer:
     frame_release(&fr);
@@ -577,13 +585,12 @@ int main(int argc, char **argv)
     Scene still;
     rc = check_scene(&o, text, &first, &last, &still);
     int have_still = !rc && first < 0; /* still is ours to render or free */
-    VbDevice dev = {0};
-    int opened = 0;
+    VbDevice devs[CLU_MAX_DEVICES];
+    int ndev = 0;
     if (!rc) {
         const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-        rc = clu_device_open(spec, &dev, err, sizeof err);
+        rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
         if (rc) diag_print("vbcl", "%s", err);
-        opened = !rc;
     }
     cJSON *json = NULL; /* the --stats-json document */
     if (rc && have_still) scene_free(&still);
@@ -593,11 +600,11 @@ int main(int argc, char **argv)
             s = still;
         else if ((rc = load_frame(&o, text, f, &s)))
             break;
-        rc = render_frame(&o, &s, f, &dev, t0, &json);
+        rc = render_frame(&o, &s, f, devs, ndev, t0, &json);
         t0 = clu_now_ms();
     }
     cJSON_Delete(json);
-    if (opened) clu_device_close(&dev);
+    clu_devices_close(devs, ndev);
     free(text);
     return rc;
 }

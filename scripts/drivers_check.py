@@ -21,6 +21,9 @@ scripts/intel-ocl.sh writes) and compares the images with the scene's tolerance:
           of the per-pixel differences (|mean(a-b)| <= 4 std(a-b) / sqrt(n)): two
           renders of the same paths can disagree pixel by pixel, not in their sum.
 
+One more render shares a frame between both drivers (--device A,B: pass 0's tiles go to
+whichever is free) and is held to the opaque bound against A alone.
+
 Prints one line per scene and exits 1 if any scene fails (docs/testing.md, "Two OpenCL
 drivers").
 """
@@ -50,6 +53,9 @@ SCENES = [
     ("prism_dispersion 96x64", "scenes/prism_dispersion.json",
      ["--width", "96", "--height", "64"], "glass", 0),
     ("high_index 64x64", "scenes/high_index.json", SMALL + ["--shadow-samples", "4"], "glass", 0),
+    # one frame shared by both drivers (--device A,B): a mixture of their pixels
+    ("quickstart 64x64 on both at once", "scenes/quickstart.json", SMALL + ["MIXED"], "opaque",
+     0),
     ("a4_two_prisms 64x64", "scenes/thesis/a4_two_prisms.json",
      SMALL + ["--shadow-samples", "4"], "chaotic", 0.10),
 ]
@@ -100,8 +106,10 @@ def main():
             if a.only and a.only not in name:
                 continue
             try:
+                dev_b = f"{a.a},{a.b}" if "MIXED" in opts else a.b
+                opts = [o for o in opts if o != "MIXED"]
                 img_a = render(a.vbcl, a.a, scene, opts, os.path.join(tmp, "a.exr"))
-                img_b = render(a.vbcl, a.b, scene, opts, os.path.join(tmp, "b.exr"))
+                img_b = render(a.vbcl, dev_b, scene, opts, os.path.join(tmp, "b.exr"))
             except RuntimeError as e:
                 print(f"drivers: {name}: FAILED: {e}", flush=True)
                 failed += 1
