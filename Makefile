@@ -25,11 +25,16 @@ endif
 # so a header is named by its file name wherever it lives.
 HOST_DIRS := host $(sort $(dir $(wildcard host/*/*.c host/*/*.h host/*/*.cpp)))
 HOST_INC  := $(patsubst %,-I%,$(patsubst %/,%,$(HOST_DIRS)))
-CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) -MMD -MP
+# MPI (docs/scaling.md): used when build/config.mk found OpenMPI; MPI=0 builds without it.
+ifeq ($(MPI),0)
+MPI_CFLAGS :=
+MPI_LIBS   :=
+endif
+CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) $(MPI_CFLAGS) -MMD -MP
 CFLAGS   := $(CSTD) $(OPT) $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -Wshadow $(SANFLAGS)
 LDFLAGS  := $(SANFLAGS)
-LDLIBS   := $(PKG_LIBS) -lm -pthread
+LDLIBS   := $(PKG_LIBS) $(MPI_LIBS) -lm -pthread
 
 HOST_C   := $(wildcard host/*.c host/*/*.c)
 HOST_CXX := $(wildcard host/*.cpp host/*/*.cpp)
@@ -51,7 +56,11 @@ build/config.mk: scripts/install-deps.sh
 	$(Q)pkg-config --exists OpenCL libcjson OpenImageIO || \
 	    { echo "vbcl: pkg-config still cannot find OpenCL, libcjson, OpenImageIO" >&2; exit 1; }
 	$(Q){ echo "PKG_CFLAGS := $$(pkg-config --cflags OpenCL libcjson OpenImageIO)"; \
-	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson OpenImageIO)"; } > $@
+	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson OpenImageIO)"; \
+	      if pkg-config --exists ompi-c 2>/dev/null; then \
+	        echo "MPI_CFLAGS := -DVBCL_MPI $$(pkg-config --cflags ompi-c)"; \
+	        echo "MPI_LIBS := $$(pkg-config --libs ompi-c)"; \
+	      else echo "# no MPI (libopenmpi-dev): vbcl runs as one process"; fi; } > $@
 
 deps:
 	scripts/install-deps.sh

@@ -1,11 +1,15 @@
 /* test_scale.c — scaling out (docs/scaling.md): a frame shared among several OpenCL devices
- * (two PoCL devices, POCL_DEVICES="pthread pthread") is the single-device image bit for
- * bit, with per-device work in --stats-json; bad --device lists are usage errors. */
+ * (two PoCL devices, POCL_DEVICES="pthread pthread") or among MPI ranks (mpirun -np 2) is
+ * the single-process image bit for bit, with per-device work in --stats-json; a failing
+ * device or rank stops the run with a message naming it and writes no image; bad --device
+ * lists are usage errors. */
 #include <cJSON.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "dist.h"
 #include "harness.h"
 #include "image_io.h"
 #include "testutil.h"
@@ -168,9 +172,146 @@ static void test_scale_bad_device_lists(void)
     }
 }
 
+/* Reads a --stats-json document (caller frees), or NULL after a failed check. */
+static cJSON *read_json(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    static char text[1 << 20];
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = 0;
+    cJSON *doc = cJSON_Parse(text);
+    CHECK(doc != NULL, "%s does not parse", path);
+    return doc;
+}
+
+/* "mpirun -np 2 --oversubscribe" (and --allow-run-as-root as root, as in CI), or NULL
+ * (the test is skipped) when this build has no MPI or mpirun is missing. */
+static const char *mpirun(void)
+{
+    if (!dist_available()) {
+        th_skip("built without MPI (libopenmpi-dev: make deps)");
+        return NULL;
+    }
+    if (tu_run("command -v mpirun", NULL, 0) != 0) {
+        th_skip("mpirun not found (openmpi-bin: make deps)");
+        return NULL;
+    }
+    return getuid() == 0 ? "mpirun --allow-run-as-root --oversubscribe" : "mpirun --oversubscribe";
+}
+
+/* Two ranks against one process: a still image (tiles), an anti-aliased one (tiles, then
+ * refinement on rank 0), and 3 frames of an animation, by the frame queue and, with
+ * --stats-json, frame by frame in tiles. */
+static void test_scale_mpi_identical(void)
+{
+    const char *mpi = mpirun();
+    if (!mpi) return;
+    static const struct {
+        const char *name, *scene, *opts;
+    } cases[] = {
+        {"quickstart", "scenes/quickstart.json", "--width 64 --height 64"},
+        {"aa", "tests/scenes/aa_edges.json", "--aa 0.1"},
+    };
+    char env[256];
+    snprintf(env, sizeof env, "%s -np 2 ", mpi);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char name[64];
+        int w1, h1, w2, h2;
+        snprintf(name, sizeof name, "mpi_%s_one", cases[k].name);
+        float *one = render("", cases[k].scene, cases[k].opts, name, &w1, &h1);
+        snprintf(name, sizeof name, "mpi_%s_two", cases[k].name);
+        float *two = render(env, cases[k].scene, cases[k].opts, name, &w2, &h2);
+        long d = differing(one, two, w1, h1, w2, h2);
+        fprintf(stderr, "    %s: 2 ranks: %ld pixels differ\n", cases[k].name, d);
+        CHECK(d == 0, "%s: 2 ranks differ from one process in %ld pixels", cases[k].name, d);
+        free(one);
+        free(two);
+    }
+    /* the animation: frames 0-2 of the thesis's figure A.6 (eta 1 to 3.7 over frames) */
+    const char *anim = "scenes/thesis/a6_eta_animation.json --frames 0:2 --width 24 --height 24 "
+                       "--shadow-samples 1";
+    const char *how[3] = {"", "", "--stats-json"};
+    char cmd[2048], out[8192];
+    for (int run = 0; run < 3; run++) {
+        char opts[256] = "";
+        if (run == 2) snprintf(opts, sizeof opts, "--stats-json %s/mpi_anim.json", tu_tmpdir());
+        snprintf(cmd, sizeof cmd, "%s%s %s -q -o %s/mpi_anim%d_##.exr %s", run ? env : "", tu_vbcl,
+                 anim, tu_tmpdir(), run, opts);
+        int rc = tu_run(cmd, out, sizeof out);
+        CHECK(rc == 0, "%s exited %d: %s", cmd, rc, out);
+    }
+    for (int run = 1; run < 3; run++)
+        for (int f = 0; f < 3; f++) {
+            char a[1024], b[1024], err[256];
+            float *pa = NULL, *pb = NULL;
+            int wa = 0, ha = 0, wb = 0, hb = 0;
+            snprintf(a, sizeof a, "%s/mpi_anim0_%02d.exr", tu_tmpdir(), f);
+            snprintf(b, sizeof b, "%s/mpi_anim%d_%02d.exr", tu_tmpdir(), run, f);
+            if (image_read(a, &wa, &ha, &pa, err, sizeof err) ||
+                image_read(b, &wb, &hb, &pb, err, sizeof err))
+                CHECK(0, "%s", err);
+            long d = differing(pa, pb, wa, ha, wb, hb);
+            CHECK(d == 0, "animation frame %d (%s): %ld pixels differ", f,
+                  run == 1 ? "frame queue" : "tiles", d);
+            free(pa);
+            free(pb);
+        }
+    fprintf(stderr, "    animation: 3 frames equal by frame queue and by tiles (%s)\n", how[2]);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/mpi_anim.json", tu_tmpdir());
+    cJSON *doc = read_json(path);
+    const cJSON *frames = cJSON_GetObjectItemCaseSensitive(doc, "frames");
+    CHECK(cJSON_GetArraySize(frames) == 3, "--stats-json: %d frames", cJSON_GetArraySize(frames));
+    const cJSON *devs = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(frames, 0), "devices");
+    double ranks = 0;
+    const cJSON *dv;
+    cJSON_ArrayForEach(dv, devs) ranks += json_num(dv, "rank");
+    CHECK(cJSON_GetArraySize(devs) == 2 && ranks == 1, "frame 0's devices: %d, ranks sum %.0f",
+          cJSON_GetArraySize(devs), ranks);
+    cJSON_Delete(doc);
+}
+
+/* A device that fails on rank 1 (VBCL_FAIL_TILE, an MPMD launch) and a rank that is killed:
+ * the run fails naming the rank (and the device), and no image is written. */
+static void test_scale_mpi_failure(void)
+{
+    const char *mpi = mpirun();
+    if (!mpi) return;
+    char cmd[4096], out[8192], img[1024];
+    snprintf(img, sizeof img, "%s/mpi_fail.png", tu_tmpdir());
+    /* 400x400: 16 tiles of about half a second each, so that rank 1 takes one */
+    const char *scene = "scenes/quickstart.json";
+    remove(img);
+    snprintf(cmd, sizeof cmd, "%s -np 1 %s %s -q -o %s : -np 1 env VBCL_FAIL_TILE=1 %s %s -q -o %s",
+             mpi, tu_vbcl, scene, img, tu_vbcl, scene, img);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "vbcl: rank 1: device 0 (") && strstr(out, "VBCL_FAIL_TILE"),
+          "a failing device on rank 1: exit %d: %s", rc, out);
+    CHECK(access(img, F_OK) != 0, "%s written after a failure", img);
+    /* rank 1 killed after 2 s of a render that takes far longer */
+    const char *slow = "scenes/glass_bombed_sphere.json --width 400 --height 400";
+    remove(img);
+    snprintf(cmd, sizeof cmd, "%s -np 1 %s %s -q -o %s : -np 1 timeout -s KILL 2 %s %s -q -o %s",
+             mpi, tu_vbcl, slow, img, tu_vbcl, slow, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc != 0 && strstr(out, "rank 1"), "rank 1 killed: exit %d: %s", rc, out);
+    CHECK(access(img, F_OK) != 0, "%s written after rank 1 died", img);
+    /* one process with two devices: the same failure names the device */
+    remove(img);
+    snprintf(cmd, sizeof cmd, TWO_POCL "VBCL_FAIL_TILE=2 %s %s -q --device all -o %s", tu_vbcl,
+             scene, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "vbcl: device ") && strstr(out, "VBCL_FAIL_TILE"),
+          "a failing device of two: exit %d: %s", rc, out);
+    CHECK(access(img, F_OK) != 0, "%s written after a device failed", img);
+}
+
 void suite_scale(void)
 {
     RUN_TEST(test_scale_devices_identical);
     RUN_TEST(test_scale_stats_per_device);
     RUN_TEST(test_scale_bad_device_lists);
+    RUN_TEST(test_scale_mpi_identical);
+    RUN_TEST(test_scale_mpi_failure);
 }

@@ -16,8 +16,9 @@ typedef struct Schedule {
     const TileSource *src;
     long next, npix, done_pix;
     int tile_pixels;
-    int running; /* device threads not yet finished */
-    int failed;  /* set by the first failure: the others stop at their next tile */
+    long taken, fail_at; /* tiles taken; VBCL_FAIL_TILE: the one that fails on purpose */
+    int running;         /* device threads not yet finished */
+    int failed;          /* set by the first failure: the others stop at their next tile */
     char err[1024];
     float *rgba;
 } Schedule;
@@ -41,8 +42,7 @@ double tiles_kernel_ms(const RenderStats *st)
     return st->camera_ms + st->intersect_ms + st->shading_ms + st->tree_ms + st->dispersion_ms;
 }
 
-/* Adds the counts and kernel times of one device's pass 0 to the frame's. */
-static void stats_add(RenderStats *to, const RenderStats *from)
+void tiles_stats_add(RenderStats *to, const RenderStats *from)
 {
     to->rays_primary += from->rays_primary;
 #define TILES_ADD_COUNTER(name, index, field, group, key) to->field += from->field;
@@ -93,8 +93,16 @@ static void *worker_run(void *arg)
         int n;
         pthread_mutex_lock(&sc->lock);
         int got = schedule_next(sc, &first, &n);
+        int inject = got > 0 && ++sc->taken == sc->fail_at;
+        if (inject) schedule_fail(sc, "%s: %s", name, "failed on purpose (VBCL_FAIL_TILE)");
         pthread_mutex_unlock(&sc->lock);
-        if (got <= 0) break;
+        if (got <= 0 || inject) break;
+        if (n > w->r->tile_pixels) { /* a tile from rank 0 must fit this rank's buffers */
+            pthread_mutex_lock(&sc->lock);
+            schedule_fail(sc, "%s: %s", name, "a tile from rank 0 is larger than its buffers");
+            pthread_mutex_unlock(&sc->lock);
+            break;
+        }
         double t0 = clu_now_ms();
         int rc = renderer_trace_tile(w->r, first, n, sc->rgba, &w->st);
         w->work->busy_ms += clu_now_ms() - t0;
@@ -166,6 +174,10 @@ int tiles_trace(Renderer *const *rs, int nr, const TileSource *src, long npix, f
     sc.npix = npix;
     sc.tile_pixels = tiles_size(rs[0]->tile_pixels, npix, nr);
     sc.rgba = rgba;
+    /* a test of the failure path (docs/scaling.md): the process's Nth tile fails as a device
+     * error would */
+    const char *fail_at = getenv("VBCL_FAIL_TILE");
+    sc.fail_at = fail_at ? atol(fail_at) : 0;
     Worker *ws = calloc((size_t)nr, sizeof *ws);
     if (!ws) {
         snprintf(err, errlen, "out of memory");
@@ -193,11 +205,13 @@ int tiles_trace(Renderer *const *rs, int nr, const TileSource *src, long npix, f
     pthread_mutex_unlock(&sc.lock);
     for (int i = 0; i < started; i++) pthread_join(ws[i].thread, NULL);
     for (int i = 0; i < started; i++) {
-        stats_add(st, &ws[i].st);
+        tiles_stats_add(st, &ws[i].st);
         work[i].rays += tiles_rays(&ws[i].st);
         work[i].kernel_ms += tiles_kernel_ms(&ws[i].st);
     }
     free(ws);
+    if (src && src->finish && src->finish(src->ctx, sc.failed, sc.err, sizeof sc.err))
+        sc.failed = 1;
     st->tile_pixels = sc.tile_pixels;
     int failed = sc.failed;
     if (failed) snprintf(err, errlen, "%s", sc.err);

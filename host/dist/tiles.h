@@ -17,6 +17,10 @@ typedef struct TileSource {
     /* Hands on a finished tile (rgba holds its n pixels); NULL when the tile stays here.
      * Returns 0, or -1 after a message in err. */
     int (*deliver)(void *ctx, long first, int n, const float *rgba, char *err, size_t errlen);
+    /* Called once after this process's devices are done (failed: whether one of them
+     * failed): waits for work elsewhere. Returns 0, or -1 (with a message in err when
+     * failed is 0). NULL: nothing to wait for. */
+    int (*finish)(void *ctx, int failed, char *err, size_t errlen);
     void *ctx;
 } TileSource;
 
@@ -37,6 +41,9 @@ unsigned long long tiles_rays(const RenderStats *st);
 /* Device time of the tracing kernels in st (camera, intersect, shading, ray trees,
  * dispersive subtrees). */
 double tiles_kernel_ms(const RenderStats *st);
+
+/* Adds the counts and kernel times of one device's (or rank's) pass 0 to st. */
+void tiles_stats_add(RenderStats *st, const RenderStats *from);
 
 /* Tiles shared among devices are no smaller than this (each launch has a fixed cost). */
 #define TILES_MIN_PIXELS 1024

@@ -41,10 +41,8 @@ int frame_devices(const Frame *fr)
     return 1 + fr->nmore;
 }
 
-/* Pass 0: one ray through the centre of each pixel, tile by tile on every device, into
- * rgba. */
-static int frame_pixel_centres(Frame *fr, const Scene *s, float *rgba, RenderStats *st,
-                               int progress, char *err, size_t errlen)
+int frame_pixel_centres(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int progress,
+                        char *err, size_t errlen)
 {
     Renderer *rs[CLU_MAX_DEVICES];
     int n = frame_devices(fr);

@@ -25,6 +25,11 @@ typedef struct Frame {
 int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
                size_t errlen);
 
+/* Pass 0 alone: one ray through the centre of each pixel, tile by tile on every device
+ * (tiles from fr->tiles), into rgba. Returns 0, or 1 with a message in err. */
+int frame_pixel_centres(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int progress,
+                        char *err, size_t errlen);
+
 /* Renderer i of the frame (0: r, the first device's), and how many there are. */
 Renderer *frame_renderer(Frame *fr, int i);
 int frame_devices(const Frame *fr);
