@@ -444,6 +444,7 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
             dist_abort(d, 1);
         }
         fr->tiles = &src;
+        st->tile_pixels = tile;
     }
     if (!rc) {
         int progress = !o->quiet && isatty(STDERR_FILENO);

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* One rank: frames first..last in order (d->next_frame starts at 0: the first call
  * begins at first). */
@@ -64,6 +65,20 @@ int dist_available(void)
     return 1;
 }
 
+/* Waits for the next message from any rank without spinning: MPI implementations poll in
+ * a blocking receive and would take a core from this rank's own devices for as long as
+ * the server waits (which is the whole render). */
+static void wait_message(MPI_Status *stt)
+{
+    for (;;) {
+        int flag = 0;
+        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, stt);
+        if (flag) return;
+        struct timespec pause = {0, 200 * 1000}; /* 0.2 ms: small against a tile */
+        nanosleep(&pause, NULL);
+    }
+}
+
 int dist_init(Dist *d, int *argc, char ***argv, char *err, size_t errlen)
 {
     memset(d, 0, sizeof *d);
@@ -94,7 +109,17 @@ int dist_init(Dist *d, int *argc, char ***argv, char *err, size_t errlen)
 int dist_agree(Dist *d, int rc)
 {
     int all = rc;
-    if (d->mpi) MPI_Allreduce(&rc, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (!d->mpi) return rc;
+    /* a rank that is done first waits here while the others render: without spinning */
+    MPI_Request req;
+    MPI_Ibarrier(MPI_COMM_WORLD, &req);
+    for (int done = 0;;) {
+        MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+        if (done) break;
+        struct timespec pause = {0, 1000 * 1000};
+        nanosleep(&pause, NULL);
+    }
+    MPI_Allreduce(&rc, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     return all;
 }
 
@@ -164,7 +189,7 @@ static void *serve_tiles(void *arg)
     DistServer *sv = d->server;
     for (int left = d->size - 1; left > 0;) {
         MPI_Status stt;
-        MPI_Probe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &stt);
+        wait_message(&stt);
         int src = stt.MPI_SOURCE, ask;
         long t[2] = {0, 0};
         if (stt.MPI_TAG == TAG_TILE_ASK) {
@@ -329,7 +354,8 @@ static void *serve_frames(void *arg)
     for (int left = d->size - 1; left > 0;) {
         MPI_Status stt;
         int msg, f = -1;
-        MPI_Recv(&msg, 1, MPI_INT, MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &stt);
+        wait_message(&stt);
+        MPI_Recv(&msg, 1, MPI_INT, stt.MPI_SOURCE, stt.MPI_TAG, MPI_COMM_WORLD, &stt);
         pthread_mutex_lock(&sv->lock);
         if (stt.MPI_TAG == TAG_FRAME_ASK && !sv->frames_stop && sv->frame_next <= sv->frame_last)
             f = sv->frame_next++;

@@ -212,7 +212,7 @@ int tiles_trace(Renderer *const *rs, int nr, const TileSource *src, long npix, f
     free(ws);
     if (src && src->finish && src->finish(src->ctx, sc.failed, sc.err, sizeof sc.err))
         sc.failed = 1;
-    st->tile_pixels = sc.tile_pixels;
+    if (!src || !src->next) st->tile_pixels = sc.tile_pixels; /* else the source's size */
     int failed = sc.failed;
     if (failed) snprintf(err, errlen, "%s", sc.err);
     pthread_cond_destroy(&sc.progress);
