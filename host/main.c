@@ -445,6 +445,7 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
         }
         fr->tiles = &src;
         st->tile_pixels = tile;
+        if (s->ssaa > 1) dist_tiles_end(d); /* supersampling runs on rank 0 alone */
     }
     if (!rc) {
         int progress = !o->quiet && isatty(STDERR_FILENO);

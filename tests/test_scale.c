@@ -201,7 +201,8 @@ static const char *mpirun(void)
 }
 
 /* Two ranks against one process: a still image (tiles), an anti-aliased one (tiles, then
- * refinement on rank 0), and 3 frames of an animation, by the frame queue and, with
+ * refinement on rank 0), a supersampled one (rank 0 alone), and 3 frames of an animation, by the
+ * frame queue and, with
  * --stats-json, frame by frame in tiles. */
 static void test_scale_mpi_identical(void)
 {
@@ -212,6 +213,7 @@ static void test_scale_mpi_identical(void)
     } cases[] = {
         {"quickstart", "scenes/quickstart.json", "--width 64 --height 64"},
         {"aa", "tests/scenes/aa_edges.json", "--aa 0.1"},
+        {"ssaa", "scenes/quickstart.json", "--width 40 --height 40 --ssaa 2"},
     };
     char env[256];
     snprintf(env, sizeof env, "%s -np 2 ", mpi);
