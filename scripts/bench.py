@@ -358,13 +358,20 @@ def part_drivers(a, out):
         scenes = scenes[:1]
     size = a.size or (16 if a.quick else 160)
     rows = []
-    for index, name in list_devices(a.vbcl):
-        for label, scene, extra in scenes:
-            dev = ["--device", str(index)]
-            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8"] + dev + extra)  # warm
-            opts = ["--width", str(size), "--height", str(size),
-                    "-o", os.path.join(a.tmp, "drivers.exr")] + dev + extra
-            st = median_stats(a.vbcl, scene, opts, a.repeats)
+    devices = list_devices(a.vbcl)
+    for label, scene, extra in scenes:
+        runs = {index: [] for index, _ in devices}
+        for index, _ in devices:  # warm each device's program cache
+            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8",
+                                      "--device", str(index)] + extra)
+        for _ in range(a.repeats):  # the devices interleaved, repeat by repeat
+            for index, _ in devices:
+                opts = ["--width", str(size), "--height", str(size), "--device", str(index),
+                        "-o", os.path.join(a.tmp, "drivers.exr")] + extra
+                runs[index].append(run_stats(a.vbcl, scene, opts))
+        for index, name in devices:
+            rs = sorted(runs[index], key=lambda r: r["total_ms"])
+            st = rs[len(rs) // 2]
             kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
             secondary = st["reflected"] + st["transmitted"]
             rows.append({
@@ -378,8 +385,8 @@ def part_drivers(a, out):
                 "kernel_ms": f"{kern:.1f}",
             })
             print(f"drivers: {rows[-1]}", flush=True)
-    note = (f"{size}x{size}, median of {a.repeats}, every device `vbcl --list-devices` shows "
-            "(Intel's CPU runtime too after `. \"$(scripts/intel-ocl.sh)\"`). primary: camera "
+    note = (f"{size}x{size}, median of {a.repeats} (the devices interleaved), every device "
+            "`vbcl --list-devices` shows (Intel's CPU runtime too after `. \"$(scripts/intel-ocl.sh)\"`). primary: camera "
             "rays over the intersect kernel's time; shadow: feelers over the shading kernel's "
             "time (which also shades the first hits); secondary: reflected and transmitted rays "
             "over the ray-tree kernel's time (which also traces their feelers); all: every ray "
