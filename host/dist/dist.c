@@ -436,10 +436,17 @@ int dist_init(Dist *d, int *argc, char ***argv, char *err, size_t errlen)
 {
     (void)argc;
     (void)argv;
-    (void)err;
-    (void)errlen;
     memset(d, 0, sizeof *d);
     d->size = 1;
+    /* under mpirun, every process would render the whole image and write the same file */
+    const char *ranks = getenv("OMPI_COMM_WORLD_SIZE");
+    if (ranks && atoi(ranks) > 1) {
+        snprintf(err, errlen,
+                 "started by mpirun with %s ranks, but this vbcl was built without MPI "
+                 "(install libopenmpi-dev: make deps; then make clean; make)",
+                 ranks);
+        return 1;
+    }
     return 0;
 }
 

@@ -22,8 +22,9 @@ typedef struct Dist {
 int dist_available(void);
 
 /* Starts MPI when the process was started by mpirun or srun (OMPI_COMM_WORLD_SIZE,
- * PMIX_RANK or PMI_RANK in the environment) in an MPI build. Returns 0, or 1 after a
- * message in err. */
+ * PMIX_RANK or PMI_RANK in the environment) in an MPI build. A build without MPI started
+ * by mpirun with several ranks fails (each would render and write the whole image).
+ * Returns 0, or 1 after a message in err. */
 int dist_init(Dist *d, int *argc, char ***argv, char *err, size_t errlen);
 
 /* The exit status every rank agrees on (the largest of all ranks' rc), after which MPI is
