@@ -25,11 +25,16 @@ endif
 # so a header is named by its file name wherever it lives.
 HOST_DIRS := host $(sort $(dir $(wildcard host/*/*.c host/*/*.h host/*/*.cpp)))
 HOST_INC  := $(patsubst %,-I%,$(patsubst %/,%,$(HOST_DIRS)))
-CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) -MMD -MP
+# MPI (docs/scaling.md): used when build/config.mk found OpenMPI; MPI=0 builds without it.
+ifeq ($(MPI),0)
+MPI_CFLAGS :=
+MPI_LIBS   :=
+endif
+CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) $(MPI_CFLAGS) -MMD -MP
 CFLAGS   := $(CSTD) $(OPT) $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -Wshadow $(SANFLAGS)
 LDFLAGS  := $(SANFLAGS)
-LDLIBS   := $(PKG_LIBS) -lm
+LDLIBS   := $(PKG_LIBS) $(MPI_LIBS) -lm -pthread
 
 HOST_C   := $(wildcard host/*.c host/*/*.c)
 HOST_CXX := $(wildcard host/*.cpp host/*/*.cpp)
@@ -39,7 +44,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz FORCE
+.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz FORCE test-drivers
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -51,7 +56,11 @@ build/config.mk: scripts/install-deps.sh
 	$(Q)pkg-config --exists OpenCL libcjson OpenImageIO || \
 	    { echo "vbcl: pkg-config still cannot find OpenCL, libcjson, OpenImageIO" >&2; exit 1; }
 	$(Q){ echo "PKG_CFLAGS := $$(pkg-config --cflags OpenCL libcjson OpenImageIO)"; \
-	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson OpenImageIO)"; } > $@
+	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson OpenImageIO)"; \
+	      if pkg-config --exists ompi-c 2>/dev/null; then \
+	        echo "MPI_CFLAGS := -DVBCL_MPI $$(pkg-config --cflags ompi-c)"; \
+	        echo "MPI_LIBS := $$(pkg-config --libs ompi-c)"; \
+	      else echo "# no MPI (libopenmpi-dev): vbcl runs as one process"; fi; } > $@
 
 deps:
 	scripts/install-deps.sh
@@ -119,8 +128,8 @@ endif
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
 # figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
-# band counts, kernel build time, rays per second against Embree. CSV, markdown and PNG in
-# bench-out/. BENCH_FLAGS passes options, e.g. BENCH_FLAGS="--parts grid --size 200".
+# band counts, kernel build time, rays per second against Embree and per OpenCL device. CSV,
+# markdown and PNG in bench-out/. BENCH_FLAGS passes options, e.g. BENCH_FLAGS="--parts grid".
 BENCH_FLAGS ?=
 # Embree, for the part "embree", is installed here (install-deps.sh --bench); where it cannot
 # be, that part measures vbcl alone.
@@ -173,6 +182,13 @@ oclgrind: $(BUILD)/vbcl
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_aa.json "$(OCLGRIND_FLAGS)"
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_dispersion.json "$(OCLGRIND_FLAGS)" 1e-3
+
+# A second OpenCL driver (docs/testing.md, "Two OpenCL drivers"): Intel's CPU runtime from
+# PyPI, installed once into ~/.cache/vbcl/intel-ocl (scripts/intel-ocl.sh), beside PoCL; the
+# same small scenes rendered on both and compared with stated tolerances.
+test-drivers: $(BUILD)/vbcl
+	$(Q)env=$$(scripts/intel-ocl.sh) && . "$$env" && \
+	    scripts/drivers_check.py --vbcl $(BUILD)/vbcl --a Portable --b Intel
 
 # libFuzzer harnesses for the scene and mesh parsers, built with clang into build/fuzz/ and
 # run from the seed corpus in tests/fuzz/corpus/ (docs/testing.md): FUZZ_RUNS executions

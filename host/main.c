@@ -14,6 +14,7 @@
 #include "frame.h"
 #include "clu.h"
 #include "diag.h"
+#include "dist.h"
 #include "kernel_features.h"
 #include "image_io.h"
 #include "fileio.h"
@@ -23,6 +24,10 @@
 #include "texgen.h"
 
 #define VBCL_VERSION "0.1.0"
+
+/* The prefix of every message: "vbcl", or "vbcl: rank N" on the other ranks of an MPI run. */
+static const char *prog = "vbcl";
+static int mpi_rank = -1; /* this process's rank in an MPI run of several, else -1 */
 
 static const char usage_text[] =
     "usage: vbcl SCENE.json [options]\n"
@@ -58,7 +63,9 @@ static const char usage_text[] =
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's deepest refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
-    "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
+    "      --device INDEX|NAME|all|LIST  OpenCL device (also VBCL_DEVICE; default: device 0);\n"
+    "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
+    "                           tiles among several (refinement runs on the first)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
     "      --stats-json FILE    write the same statistics as JSON (fields: docs/stats.md);\n"
@@ -69,6 +76,8 @@ static const char usage_text[] =
     "\n"
     "environment: VBCL_DEVICE (as --device), VBCL_CACHE_DIR (kernel binary cache;\n"
     "\"off\" disables it; default ~/.cache/vbcl)\n"
+    "mpirun -np N vbcl SCENE.json ...: the ranks share a still image's tiles, and an\n"
+    "animation's frames (frame by frame in tiles with --stats-json); docs/scaling.md\n"
     "exit status: 0 success, 2 bad input or usage, 1 device or render failure\n"
     "scene format: docs/scene-format.md\n";
 
@@ -91,7 +100,7 @@ static int usage_error(const char *fmt, ...)
     va_start(ap, fmt);
     diag_vformat(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    diag_print("vbcl", "%s (see vbcl --help)", msg);
+    diag_print(prog, "%s (see vbcl --help)", msg);
     return 2;
 }
 
@@ -101,7 +110,7 @@ static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
     errno = 0;
     long v = strtol(s, &end, 10);
     if (end == s || *end || errno || v < lo || v > hi) {
-        diag_print("vbcl", "%s %s: expected a whole number from %d to %d", opt, diag_value(s), lo,
+        diag_print(prog, "%s %s: expected a whole number from %d to %d", opt, diag_value(s), lo,
                    hi);
         return -1;
     }
@@ -115,8 +124,8 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
     errno = 0;
     double v = strtod(s, &end);
     if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        diag_print("vbcl", "%s %s: expected a number from %s to %s", opt, diag_value(s),
-                   diag_num(lo), diag_num(hi));
+        diag_print(prog, "%s %s: expected a number from %s to %s", opt, diag_value(s), diag_num(lo),
+                   diag_num(hi));
         return -1;
     }
     *out = v;
@@ -390,9 +399,15 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
     if (!o->quiet) {
         unsigned long long rays = stats_rays_total(fr->st);
         double render_ms = fr->st->render_ms;
+        char on[300];
+        if (fr->nwork > 1)
+            snprintf(on, sizeof on, "%d devices (--stats: each one's share)", fr->nwork);
+        else
+            snprintf(on, sizeof on, "%s", fr->dev->name);
+        if (mpi_rank >= 0) snprintf(on + strlen(on), sizeof on - strlen(on), ", rank %d", mpi_rank);
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s->width, s->height, fr->total_ms / 1000.0, s->mesh.ntris, rays,
-               render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, fr->dev->name);
+               render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, on);
         fflush(stdout);
     }
     return 0;
@@ -405,7 +420,7 @@ static int load_frame(const Options *o, const char *text, int frame, Scene *s)
 {
     char err[1024] = "";
     if (scene_load_text(o->scene, text, frame, s, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
+        diag_print(prog, "%s", err);
         return 2;
     }
     int rc = apply_options(o, s);
@@ -413,63 +428,116 @@ static int load_frame(const Options *o, const char *text, int frame, Scene *s)
     return rc;
 }
 
+/* The frame's image on this process's devices into rgba, with the other MPI ranks' help
+ * when d shares tiles (d->size > 1; this is rank 0: it serves pass 0's tiles and gathers
+ * the ranks' pixels and work). Leaves every device's work in work[0..*nwork) (room for
+ * max). Returns 0, or an exit status after a message. */
+static int render_image(const Options *o, const Scene *s, VbDevice *devs, int ndev, Dist *d,
+                        Frame *fr, float *rgba, RenderStats *st, DeviceWork *work, int *nwork,
+                        int max)
+{
+    char err[1024] = "";
+    long npix = (long)s->width * s->height;
+    int shared = d && d->size > 1;
+    TileSource src;
+    int rc = frame_init(fr, devs, ndev, s, st, err, sizeof err);
+    if (shared) {
+        int tile = rc ? TILES_MIN_PIXELS : tiles_size(fr->r.tile_pixels, npix, d->size * ndev);
+        if (dist_tiles_begin(d, rgba, npix, tile, &src, err, sizeof err)) {
+            diag_print(prog, "%s", err);
+            dist_abort(d, 1);
+        }
+        fr->tiles = &src;
+        st->tile_pixels = tile;
+        if (s->ssaa > 1) dist_tiles_end(d); /* supersampling runs on rank 0 alone */
+    }
+    if (!rc) {
+        int progress = !o->quiet && isatty(STDERR_FILENO);
+        rc = frame_render(fr, s, rgba, st, progress, err, sizeof err) ? 1 : 0;
+    }
+    if (shared) dist_tiles_end(d);
+    fr->tiles = NULL; /* src ends here */
+    if (rc) {
+        diag_print(prog, "%s", err);
+        return rc;
+    }
+    for (int i = 0; i < ndev; i++) work[i] = fr->work[i];
+    *nwork = shared ? dist_tiles_gather(d, st, work, ndev, max) : ndev;
+    return 0;
+}
+
 /* Renders frame `frame` of the loaded scene *scene (its command line applied; freed here)
- * on dev, writes it and reports it (report_frame; *json: the --stats-json document); t0
- * is when this frame's work began. Returns an exit status. */
-static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev, double t0,
-                        cJSON **json)
+ * on devs, with the other ranks' help when d shares tiles (render_image; else NULL),
+ * writes it and reports it (report_frame; *json: the --stats-json document); t0 is when
+ * this frame's work began. Returns an exit status. */
+static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *devs, int ndev,
+                        Dist *d, double t0, cJSON **json)
 {
     char err[1024] = "";
     Scene s = *scene;
-    int rc = 0;
+    int rc = 0, nwork = 0, max = ndev + (d ? d->size - 1 : 0) * CLU_MAX_DEVICES;
     char *out = output_path(o, &s, frame);
     char *map = !o->aa_map ? NULL : frame_path(o->aa_map, frame);
-    float *rgba = NULL;
+    float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
+    DeviceWork *work = calloc((size_t)max, sizeof *work);
     Frame fr;
     memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (!out || (o->aa_map && !map)) {
-        fprintf(stderr, "vbcl: out of memory\n");
+    if (!out || (o->aa_map && !map) || !rgba || !work) {
+        fprintf(stderr, "%s: out of memory for a %dx%d image\n", prog, s.width, s.height);
         rc = 1;
-        goto done_scene;
+        dist_abort(d, 1); /* with other ranks: they wait for tiles */
+        goto done;
     }
-    rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
-    if (!rgba) {
-        fprintf(stderr, "vbcl: cannot allocate a %dx%d image\n", s.width, s.height);
-        rc = 1;
-        goto done_scene;
-    }
-    rc = frame_init(&fr, dev, &s, &st, err, sizeof err);
-    if (rc) {
-        diag_print("vbcl", "%s", err);
-        goto done_renderer;
-    }
-    int progress = !o->quiet && isatty(STDERR_FILENO);
-    if (frame_render(&fr, &s, rgba, &st, progress, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
-        rc = 1;
-        goto done_renderer;
-    }
+    rc = render_image(o, &s, devs, ndev, d, &fr, rgba, &st, work, &nwork, max);
+    if (rc) goto done;
     double tw = clu_now_ms();
-    if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
+    if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err) ||
+        (map && frame_levels(&fr) && write_aa_map(map, &s, frame_levels(&fr), err, sizeof err))) {
+        diag_print(prog, "%s", err);
         rc = 1;
-        goto done_renderer;
+        goto done;
     }
-    if (map && frame_levels(&fr) && write_aa_map(map, &s, frame_levels(&fr), err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
-        rc = 1;
-        goto done_renderer;
-    }
-    StatsFrame sf = {&s, dev, &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0};
+    StatsFrame sf = {&s,   &devs[0], &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0,
+                     work, nwork};
     rc = report_frame(o, &sf, out, json);
-done_renderer:
+done:
     frame_release(&fr);
-done_scene:
     free(rgba);
+    free(work);
     free(out);
     free(map);
+    scene_free(&s);
+    return rc;
+}
+
+/* Another rank's part of a frame shared by tiles (d->size > 1, rank > 0): pass 0's tiles
+ * from rank 0, traced on this rank's devices, the pixels and the work sent back. *scene is
+ * freed here. Returns 0, or 1 (rank 0 reports the failure). */
+static int render_tiles_for_rank0(Dist *d, Scene *scene, VbDevice *devs, int ndev)
+{
+    char err[1024] = "";
+    Scene s = *scene;
+    float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
+    Frame fr;
+    memset(&fr, 0, sizeof fr);
+    RenderStats st;
+    memset(&st, 0, sizeof st);
+    TileSource src;
+    dist_tiles_begin(d, rgba, (long)s.width * s.height, 0, &src, err, sizeof err);
+    int rc = 1;
+    if (!rgba)
+        snprintf(err, sizeof err, "cannot allocate a %dx%d image", s.width, s.height);
+    else
+        rc = frame_init(&fr, devs, ndev, &s, &st, err, sizeof err);
+    if (!rc) {
+        fr.tiles = &src;
+        rc = frame_pixel_centres(&fr, &s, rgba, &st, 0, err, sizeof err);
+    }
+    if (dist_tiles_report(d, rc, err, &st, fr.work, frame_devices(&fr))) rc = 1;
+    frame_release(&fr);
+    free(rgba);
     scene_free(&s);
     return rc;
 }
@@ -480,7 +548,7 @@ static int check_output_dir(const char *path)
 {
     char err[1024];
     if (file_check_dir(path, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
+        diag_print(prog, "%s", err);
         return 2;
     }
     return 0;
@@ -492,7 +560,7 @@ static int check_output(const char *path)
 {
     char err[1024];
     if (image_check_path(path, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
+        diag_print(prog, "%s", err);
         return 2;
     }
     return check_output_dir(path);
@@ -561,47 +629,96 @@ static int check_scene(const Options *o, const char *text, int *first, int *last
     return rc;
 }
 
-int main(int argc, char **argv)
+/* Renders frames first..last (first = last = -1: the still image *still, freed here),
+ * each one shared by tiles among the MPI ranks (with one rank: on this process's devices),
+ * or, for an animation over several ranks without --stats-json, whole frames handed out
+ * one at a time (each rank writes its own). Returns an exit status. */
+static int render_all(const Options *o, Dist *d, const char *text, int first, int last,
+                      Scene *still, VbDevice *devs, int ndev, double t0)
 {
-    if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
-    double t0 = clu_now_ms();
+    cJSON *json = NULL; /* the --stats-json document */
+    int rc = 0, f;
+    if (first >= 0 && d->size > 1 && !o->stats_json) {
+        while (!rc && dist_frames_next(d, first, last, &f)) {
+            Scene s;
+            rc = load_frame(o, text, f, &s);
+            if (!rc) rc = render_frame(o, &s, f, devs, ndev, NULL, t0, &json);
+            t0 = clu_now_ms();
+        }
+        if (rc) dist_frames_fail(d);
+        dist_frames_end(d);
+        return rc;
+    }
+    for (f = first; !rc && f <= last; f++) {
+        Scene s;
+        if (f < 0)
+            s = *still;
+        else if ((rc = load_frame(o, text, f, &s)))
+            break;
+        if (d->rank == 0)
+            rc = render_frame(o, &s, f, devs, ndev, d, t0, &json);
+        else
+            rc = render_tiles_for_rank0(d, &s, devs, ndev);
+        rc = dist_agree(d, rc);
+        t0 = clu_now_ms();
+    }
+    cJSON_Delete(json);
+    return rc;
+}
+
+/* The command line on this rank: the scene read and checked by rank 0 (once: it may be a
+ * pipe), every frame and output path checked before any device is opened, then shared
+ * with the other ranks; each rank opens its devices; then render_all. */
+static int run(Dist *d, int argc, char **argv, double t0)
+{
     Options o;
     int rc = parse_args(argc, argv, &o);
     if (rc >= 0) return rc;
     if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
-
-    /* the scene, read once (it may be a pipe), checked as written and in every frame to be
-     * rendered, and every output path, before any device is opened */
     char err[1024] = "", *text = NULL;
     int first = -1, last = -2;
-    if (scene_read_text(o.scene, &text, err, sizeof err)) {
-        diag_print("vbcl", "%s", err);
-        return 2;
-    }
     Scene still;
-    rc = check_scene(&o, text, &first, &last, &still);
+    if (d->rank == 0) {
+        rc = scene_read_text(o.scene, &text, err, sizeof err) ? 2 : 0;
+        if (rc) diag_print(prog, "%s", err);
+        if (!rc) rc = check_scene(&o, text, &first, &last, &still);
+    }
+    if (dist_share_scene(d, &text, &rc, &first, &last)) dist_abort(d, 1);
+    if (!rc && d->rank != 0 && first < 0) rc = load_frame(&o, text, -1, &still);
     int have_still = !rc && first < 0; /* still is ours to render or free */
-    VbDevice dev = {0};
-    int opened = 0;
+    VbDevice devs[CLU_MAX_DEVICES];
+    int ndev = 0;
     if (!rc) {
         const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-        rc = clu_device_open(spec, &dev, err, sizeof err);
-        if (rc) diag_print("vbcl", "%s", err);
-        opened = !rc;
+        rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
+        if (rc) diag_print(prog, "%s", err);
+        rc = dist_agree(d, rc); /* every rank has its devices, or all stop */
     }
-    cJSON *json = NULL; /* the --stats-json document */
-    if (rc && have_still) scene_free(&still);
-    for (int f = first; !rc && f <= last; f++) {
-        Scene s;
-        if (f < 0)
-            s = still;
-        else if ((rc = load_frame(&o, text, f, &s)))
-            break;
-        rc = render_frame(&o, &s, f, &dev, t0, &json);
-        t0 = clu_now_ms();
+    if (!rc) {
+        have_still = 0; /* render_all frees it */
+        rc = render_all(&o, d, text, first, last, &still, devs, ndev, t0);
     }
-    cJSON_Delete(json);
-    if (opened) clu_device_close(&dev);
+    if (have_still) scene_free(&still);
+    clu_devices_close(devs, ndev);
     free(text);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
+    double t0 = clu_now_ms();
+    Dist d;
+    char err[1024] = "";
+    if (dist_init(&d, &argc, &argv, err, sizeof err)) {
+        diag_print(prog, "%s", err);
+        return 1;
+    }
+    static char rank_prog[64];
+    if (d.size > 1) mpi_rank = d.rank;
+    if (d.size > 1 && d.rank > 0) {
+        snprintf(rank_prog, sizeof rank_prog, "vbcl: rank %d", d.rank);
+        prog = rank_prog;
+    }
+    return dist_finish(&d, run(&d, argc, argv, t0));
 }

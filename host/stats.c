@@ -126,6 +126,13 @@ void stats_print(FILE *f, const StatsFrame *fr)
             st->dispersion_ms, st->readback_ms, st->render_ms, fr->write_ms, fr->total_ms);
     fprintf(f, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
             kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
+    for (int i = 0; i < fr->nwork; i++) {
+        const DeviceWork *w = &fr->work[i];
+        fprintf(f,
+                "device %-4d rank %d, %s: %llu tiles, %llu rays, busy %.1f ms (wall), kernels "
+                "%.1f ms (device)\n",
+                w->index, w->rank, w->name, w->tiles, w->rays, w->busy_ms, w->kernel_ms);
+    }
 }
 
 /* ---- the --stats-json document ---- */
@@ -298,6 +305,19 @@ static void json_times(cJSON *root, const StatsFrame *fr, int *ok)
     o = obj(root, "tiles", ok);
     num(o, "count", st->tiles, ok);
     num(o, "max_pixels", st->tile_pixels, ok);
+    cJSON *devs = arr(root, "devices", ok);
+    for (int i = 0; i < fr->nwork && devs; i++) {
+        const DeviceWork *w = &fr->work[i];
+        cJSON *d = cJSON_CreateObject();
+        num(d, "index", w->index, ok);
+        num(d, "rank", w->rank, ok);
+        str(d, "name", w->name, ok);
+        num(d, "tiles", (double)w->tiles, ok);
+        num(d, "rays", (double)w->rays, ok);
+        num(d, "busy_ms", w->busy_ms, ok);
+        num(d, "kernel_ms", w->kernel_ms, ok);
+        push(devs, d, ok);
+    }
 }
 
 cJSON *stats_json(const StatsFrame *fr)

@@ -10,6 +10,7 @@
 #include "clu.h"
 #include "render.h"
 #include "scene.h"
+#include "tiles.h"
 
 /* One rendered frame and what it took. */
 typedef struct StatsFrame {
@@ -17,9 +18,11 @@ typedef struct StatsFrame {
     const VbDevice *dev;
     const Renderer *r;
     const RenderStats *st;
-    int frame;       /* frame of an animation, or -1 */
-    double write_ms; /* wall time of writing the image (and --aa-map) */
-    double total_ms; /* wall time of the frame's work, from loading the scene on */
+    int frame;              /* frame of an animation, or -1 */
+    double write_ms;        /* wall time of writing the image (and --aa-map) */
+    double total_ms;        /* wall time of the frame's work, from loading the scene on */
+    const DeviceWork *work; /* what each device did (tiles.h), nwork of them */
+    int nwork;
 } StatsFrame;
 
 /* Rays traced: primary + refinement + shadow + reflected + transmitted. */

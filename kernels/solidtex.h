@@ -65,16 +65,24 @@ VBST_FN float solidtex_fourier_eval(VB_GLOBAL const VbFourier *f, float x, float
     return gx * gy * gz;
 }
 
+/* Points within this distance of the unit square count as on its edge: a surface that
+ * lies on the square's boundary (a box face at the projection's origin) computes its hit
+ * points to within a few ulps either side, and would otherwise be speckled with R = 0
+ * where rounding (which differs between OpenCL drivers) puts a point just outside. */
+#define SOLIDTEX_PROJECTION_EDGE 1e-5f
+
 /* Orthogonal projection along Z (thesis 2.1.3): the texel of a width x height image
- * (rows top first) nearest to (x, y), with x to the right and y up, both in [0, 1];
- * -1 outside that square, where R is 0. The caller reads the texel's channels. */
+ * (rows top first) nearest to (x, y), with x to the right and y up, both in [0, 1]
+ * (widened by SOLIDTEX_PROJECTION_EDGE); -1 outside that square, where R is 0. The caller
+ * reads the texel's channels. */
 VBST_FN int solidtex_projection_texel(int width, int height, float x, float y)
 {
-    if (!(x >= 0.0f && x <= 1.0f && y >= 0.0f && y <= 1.0f)) return -1;
+    const float e = SOLIDTEX_PROJECTION_EDGE;
+    if (!(x >= -e && x <= 1.0f + e && y >= -e && y <= 1.0f + e)) return -1;
     int col = (int)VBST_FLOOR(x * (float)width);
     int row = (int)VBST_FLOOR((1.0f - y) * (float)height);
-    col = col < width ? col : width - 1;
-    row = row < height ? row : height - 1;
+    col = col < 0 ? 0 : col < width ? col : width - 1;
+    row = row < 0 ? 0 : row < height ? row : height - 1;
     return row * width + col;
 }
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""bench.py — `make bench`: the thesis's own measurements and ours, in five parts.
+"""bench.py — `make bench`: the thesis's own measurements and ours, in six parts.
 
   1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
               threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
@@ -10,10 +10,13 @@
               anti-aliasing thresholds (scripts/bench_aa.py) and for band counts;
   4. build    kernel build time, cold (empty binary cache) and warm, per feature set;
   5. embree   Mrays/s per ray kind against Embree 3 on the same triangles and rays
-              (build/vbcl-bench-rays, tests/bench/bench_rays.c; vbcl alone without Embree).
+              (build/vbcl-bench-rays, tests/bench/bench_rays.c; vbcl alone without Embree);
+  6. drivers  Mrays/s by ray kind on every OpenCL device vbcl sees (PoCL; Intel's CPU
+              runtime too after `. "$(scripts/intel-ocl.sh)"`), to pick a driver.
 
-usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build,embree] [--vbcl ./vbcl]
-                        [--out bench-out] [--size N] [--repeats N] [--bench-rays PATH]
+usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build,embree,drivers]
+                        [--vbcl ./vbcl] [--out bench-out] [--size N] [--repeats N]
+                        [--bench-rays PATH]
 
 Writes OUT/<part>.csv, OUT/<part>.md and, for parts 2 and 3, OUT/<part>.png; OUT/bench.md
 collects the markdown tables with the machine and device they were measured on. Times come
@@ -341,6 +344,62 @@ def part_build(a, out):
                        "Kernel build time, cold and warm", note)
 
 
+def list_devices(vbcl, env=None):
+    """(index, "platform / device") of every OpenCL device vbcl sees."""
+    text = subprocess.run([vbcl, "--list-devices"], capture_output=True, text=True,
+                          env=env).stdout
+    return [(int(m.group(1)), m.group(2)) for m in re.finditer(r"^(\d+): (.*)$", text, re.M)]
+
+
+def part_drivers(a, out):
+    """Mrays/s by ray kind on every OpenCL device this process sees (with Intel's runtime
+    after `. "$(scripts/intel-ocl.sh)"`), so a user can see which driver to pick."""
+    scenes = [("quickstart (opaque)", "scenes/quickstart.json", []),
+              ("glass_bombed_sphere (glass)", "scenes/glass_bombed_sphere.json",
+               ["--shadow-samples", "4"])]
+    if a.quick:
+        scenes = scenes[:1]
+    size = a.size or (16 if a.quick else 160)
+    rows = []
+    devices = list_devices(a.vbcl)
+    for label, scene, extra in scenes:
+        runs = {index: [] for index, _ in devices}
+        for index, _ in devices:  # warm each device's program cache
+            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8",
+                                      "--device", str(index)] + extra)
+        for _ in range(a.repeats):  # the devices interleaved, repeat by repeat
+            for index, _ in devices:
+                opts = ["--width", str(size), "--height", str(size), "--device", str(index),
+                        "-o", os.path.join(a.tmp, "drivers.exr")] + extra
+                runs[index].append(run_stats(a.vbcl, scene, opts))
+        for index, name in devices:
+            rs = sorted(runs[index], key=lambda r: r["total_ms"])
+            st = rs[len(rs) // 2]
+            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+            secondary = st["reflected"] + st["transmitted"]
+            rows.append({
+                "device": f"{index}: {name}", "scene": label,
+                "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
+                "shadow_mrays_s": (f"{st['rays_shadow'] / (st['shading_ms'] * 1e3):.2f}"
+                                   if st["shading_ms"] > 0 else ""),
+                "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
+                                      if st["tree_ms"] > 0 else ""),
+                "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
+                "kernel_ms": f"{kern:.1f}",
+            })
+            print(f"drivers: {rows[-1]}", flush=True)
+    note = (f"{size}x{size}, median of {a.repeats} (the devices interleaved), every device "
+            "`vbcl --list-devices` shows (Intel's CPU runtime too after `. \"$(scripts/intel-ocl.sh)\"`). primary: camera "
+            "rays over the intersect kernel's time; shadow: feelers over the shading kernel's "
+            "time (which also shades the first hits); secondary: reflected and transmitted rays "
+            "over the ray-tree kernel's time (which also traces their feelers); all: every ray "
+            "over all tracing kernels' time.")
+    return write_table(out, "drivers", rows,
+                       ["device", "scene", "primary_mrays_s", "shadow_mrays_s",
+                        "secondary_mrays_s", "all_mrays_s", "kernel_ms"],
+                       "Throughput per OpenCL device", note)
+
+
 # Part 5: scenes traced by vbcl and Embree; each with --grid auto and, where it has one, the
 # scene's own grid (label, path).
 EMBREE_SCENES = [
@@ -422,7 +481,7 @@ def machine(vbcl):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes: every part runs (CI)")
-    ap.add_argument("--parts", default="thesis,grid,error,build,embree")
+    ap.add_argument("--parts", default="thesis,grid,error,build,embree,drivers")
     ap.add_argument("--vbcl", default="./vbcl")
     ap.add_argument("--out", default="bench-out")
     ap.add_argument("--size", type=int, default=0, help="image size of parts 1 and 2")
@@ -435,7 +494,7 @@ def main():
     a.repeats = a.repeats or (1 if a.quick else 3)
     os.makedirs(a.out, exist_ok=True)
     parts = {"thesis": part_thesis, "grid": part_grid, "error": part_error, "build": part_build,
-             "embree": part_embree}
+             "embree": part_embree, "drivers": part_drivers}
     chosen = [p.strip() for p in a.parts.split(",") if p.strip()]
     for p in chosen:
         if p not in parts:

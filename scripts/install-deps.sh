@@ -7,7 +7,8 @@
 set -eu
 
 PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo oclgrind clang \
-libcjson-dev libopenimageio-dev openimageio-tools python3 python3-numpy python3-matplotlib"
+libcjson-dev libopenimageio-dev openimageio-tools python3 python3-numpy python3-matplotlib python3-venv \
+libopenmpi-dev openmpi-bin"
 BENCH_PACKAGES="libembree-dev"
 
 case "${1:-}" in

@@ -109,5 +109,6 @@ int main(int argc, char **argv)
     suite_aa();
     suite_dispersion();
     suite_structure();
+    suite_scale();
     return th_summary();
 }

@@ -86,24 +86,32 @@ static void test_patterns_probe_matches_host(void)
     CHECK(worst < 1e-5, "kernel G equals the host's within 1e-5 (%.3g)", worst);
     CHECK(hi > lo + 0.05, "the pattern varies (%.3f..%.3f)", lo, hi);
     /* projection: texel centres of a 4 x 2 image over the unit square, and two points outside */
-    float tp[10 * 4];
+    float tp[14 * 4];
     for (int t = 0; t < 8; t++) {
         int col = t % 4, row = t / 4;
         tp[4 * t] = (col + 0.5f) / 4, tp[4 * t + 1] = 1 - (row + 0.5f) / 2, tp[4 * t + 2] = 0.3f;
     }
     tp[32] = 1.2f, tp[33] = 0.5f, tp[36] = 0.5f, tp[37] = -0.1f;
+    /* rounding either side of the square's edges: the edge texels (a box face on the
+     * square's boundary is not speckled with zeros) */
+    tp[40] = -1e-6f, tp[41] = 0.9f, tp[44] = 1.0f + 1e-6f, tp[45] = 0.1f;
+    tp[48] = 0.1f, tp[49] = 1.0f + 1e-6f, tp[52] = 0.9f, tp[53] = -1e-6f;
     cl_mem mt = buffer(tp, sizeof tp), mq = buffer(NULL, sizeof tp);
-    n = 10;
+    n = 14;
     mat = 2; /* "img" */
     const void *v2[] = {&mat, &mt, &n, &mq};
-    fixture_run_probe(&fx, "probe_pattern", 10, 4, sz, v2);
-    float got[10 * 4];
+    fixture_run_probe(&fx, "probe_pattern", 14, 4, sz, v2);
+    float got[14 * 4];
     read_buffer(mq, got, sizeof got);
     for (int t = 0; t < 8; t++)
         for (int c = 0; c < 3; c++)
             CHECK(got[4 * t + c] == image[t][c], "texel %d channel %d: %g, image %g", t, c,
                   got[4 * t + c], image[t][c]);
     CHECK(got[32] == 0 && got[36] == 0, "zero outside the unit square (%g, %g)", got[32], got[36]);
+    static const int edge_texel[4] = {0, 7, 0, 7};
+    for (int k = 0; k < 4; k++)
+        CHECK(got[40 + 4 * k] == image[edge_texel[k]][0], "1e-6 beyond edge %d: texel %d (%g, %g)",
+              k, edge_texel[k], got[40 + 4 * k], image[edge_texel[k]][0]);
     clReleaseMemObject(mp);
     clReleaseMemObject(mo);
     clReleaseMemObject(mt);

@@ -37,5 +37,6 @@ void suite_render(void);
 void suite_aa(void);
 void suite_dispersion(void);
 void suite_structure(void);
+void suite_scale(void);
 
 #endif

@@ -16,7 +16,8 @@
 #include <time.h>
 #include <unistd.h>
 
-static char first_error[1024];
+/* per thread: each device of a multi-device render runs in its own host thread */
+static _Thread_local char first_error[1024];
 
 const char *clu_error_name(cl_int code)
 {
@@ -191,47 +192,85 @@ static int contains_nocase(const char *hay, const char *needle)
     return n == 0;
 }
 
-int clu_device_open(const char *spec, VbDevice *d, char *err, size_t errlen)
+/* The device one item of a --device list names: an index, or the first device whose
+ * "platform / device" contains it. Returns the index, or -1 after a message in err. */
+static int device_pick(const char *spec, const char *item, cl_platform_id *plats,
+                       cl_device_id *devs, int n, char *err, size_t errlen)
+{
+    char *end;
+    long idx = strtol(item, &end, 10);
+    if (*end == 0 && end != item) {
+        if (idx >= 0 && idx < n) return (int)idx;
+        snprintf(err, errlen, "--device %s: no such device %s (there are %d; see --list-devices)",
+                 spec, item, n);
+        return -1;
+    }
+    for (int i = 0; i < n; i++) {
+        char name[256];
+        full_name(plats[i], devs[i], name, sizeof name);
+        if (contains_nocase(name, item)) return i;
+    }
+    snprintf(err, errlen, "--device %s: no device name contains \"%s\" (see --list-devices)", spec,
+             item);
+    return -1;
+}
+
+int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t errlen)
+{
+    cl_platform_id plats[64];
+    cl_device_id devs[64];
+    int n = enumerate(plats, devs, 64), count = 0;
+    if (n == 0) {
+        snprintf(err, errlen,
+                 "no OpenCL device found: install an OpenCL driver (make deps "
+                 "installs PoCL) and check with clinfo");
+        return -1;
+    }
+    if (!spec || !*spec) spec = "0";
+    if (!strcmp(spec, "all")) {
+        for (int i = 0; i < n && i < max; i++) picks[count++] = i;
+        return count;
+    }
+    char item[256];
+    for (const char *p = spec;; p++) {
+        size_t len = strcspn(p, ",");
+        if (len == 0 || len >= sizeof item) {
+            snprintf(err, errlen,
+                     "--device %s: expected all, or indices and names separated by commas", spec);
+            return -2;
+        }
+        memcpy(item, p, len);
+        item[len] = 0;
+        int pick = device_pick(spec, item, plats, devs, n, err, errlen);
+        if (pick < 0) return -2;
+        for (int k = 0; k < count; k++)
+            if (picks[k] == pick) {
+                snprintf(err, errlen, "--device %s: device %d is named twice", spec, pick);
+                return -2;
+            }
+        if (count == max) {
+            snprintf(err, errlen, "--device %s: at most %d devices", spec, max);
+            return -2;
+        }
+        picks[count++] = pick;
+        p += len;
+        if (!*p) return count;
+    }
+}
+
+int clu_device_open_index(int index, VbDevice *d, char *err, size_t errlen)
 {
     cl_platform_id plats[64];
     cl_device_id devs[64];
     memset(d, 0, sizeof *d);
     int n = enumerate(plats, devs, 64);
-    if (n == 0) {
-        snprintf(err, errlen,
-                 "no OpenCL device found: install an OpenCL driver (make deps "
-                 "installs PoCL) and check with clinfo");
+    if (index < 0 || index >= n) {
+        snprintf(err, errlen, "OpenCL device %d is gone (there are %d)", index, n);
         return 1;
     }
-    int pick = -1;
-    if (!spec || !*spec) {
-        pick = 0;
-    } else {
-        char *end;
-        long idx = strtol(spec, &end, 10);
-        if (*end == 0 && end != spec) {
-            if (idx < 0 || idx >= n) {
-                snprintf(err, errlen,
-                         "--device %s: no such device (there are %d; see --list-devices)", spec, n);
-                return 2;
-            }
-            pick = (int)idx;
-        } else {
-            for (int i = 0; i < n && pick < 0; i++) {
-                char name[256];
-                full_name(plats[i], devs[i], name, sizeof name);
-                if (contains_nocase(name, spec)) pick = i;
-            }
-            if (pick < 0) {
-                snprintf(err, errlen,
-                         "--device %s: no device name contains \"%s\" (see --list-devices)", spec,
-                         spec);
-                return 2;
-            }
-        }
-    }
-    d->platform = plats[pick];
-    d->device = devs[pick];
+    d->index = index;
+    d->platform = plats[index];
+    d->device = devs[index];
     full_name(d->platform, d->device, d->name, sizeof d->name);
     clGetDeviceInfo(d->device, CL_DEVICE_VERSION, sizeof d->version, d->version, NULL);
     clGetDeviceInfo(d->device, CL_DRIVER_VERSION, sizeof d->driver, d->driver, NULL);
@@ -253,6 +292,39 @@ fail_context:
 fail:
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
+}
+
+int clu_device_open(const char *spec, VbDevice *d, char *err, size_t errlen)
+{
+    int pick;
+    int n = clu_device_pick(spec, &pick, 1, err, errlen);
+    if (n == -1) return 1;
+    if (n < 0) return 2;
+    return clu_device_open_index(pick, d, err, errlen);
+}
+
+int clu_devices_open(const char *spec, VbDevice *devs, int max, int *ndev, char *err, size_t errlen)
+{
+    int picks[CLU_MAX_DEVICES];
+    *ndev = 0;
+    int n =
+        clu_device_pick(spec, picks, max < CLU_MAX_DEVICES ? max : CLU_MAX_DEVICES, err, errlen);
+    if (n == -1) return 1;
+    if (n < 0) return 2;
+    for (int i = 0; i < n; i++) {
+        int rc = clu_device_open_index(picks[i], &devs[i], err, errlen);
+        if (rc) {
+            clu_devices_close(devs, i);
+            return rc;
+        }
+    }
+    *ndev = n;
+    return 0;
+}
+
+void clu_devices_close(VbDevice *devs, int n)
+{
+    for (int i = 0; i < n; i++) clu_device_close(&devs[i]);
 }
 
 void clu_device_close(VbDevice *d)

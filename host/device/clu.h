@@ -14,6 +14,7 @@ typedef struct VbDevice {
     cl_device_id device;
     cl_context context;
     cl_command_queue queue;
+    int index;         /* in clu_list_devices's order */
     char name[256];    /* "platform / device" */
     char version[128]; /* device version */
     char driver[128];  /* driver version */
@@ -24,8 +25,9 @@ typedef struct VbDevice {
 /* The name of an OpenCL error code ("CL_OUT_OF_RESOURCES"). */
 const char *clu_error_name(cl_int code);
 
-/* Records the first failed call (later ones are ignored until clu_error_clear) with the
- * call text, file, line and the error's name; returns -1 so callers can `return`. */
+/* Records the first failed call of this thread (later ones are ignored until
+ * clu_error_clear) with the call text, file, line and the error's name; returns -1 so
+ * callers can `return`. */
 int clu_fail(cl_int code, const char *call, const char *file, int line);
 /* The first recorded error message, or "" when none. */
 const char *clu_error(void);
@@ -62,11 +64,30 @@ void clu_error_clear(void);
 /* Prints every platform and device with its index. Returns the number of devices. */
 int clu_list_devices(FILE *out);
 
-/* Opens the device chosen by spec: an index from clu_list_devices, or a case-insensitive
- * part of "platform / device"; NULL or "" takes device 0. Returns 0, 2 when spec matches
- * nothing (usage error), or 1 on an OpenCL failure (clu_error() says which). */
+/* The most devices one process drives (--device all takes the first this many). */
+#define CLU_MAX_DEVICES 16
+
+/* The devices spec names, as indices of clu_list_devices: "all", or a comma-separated list
+ * of items, each an index or a case-insensitive part of "platform / device" (the first
+ * device that contains it); NULL or "" is device 0. Returns how many (<= max) are in
+ * picks, -1 when there is no OpenCL device at all, or -2 when spec is not a valid list
+ * (a usage error: an item that matches nothing, a device named twice); err says which. */
+int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t errlen);
+
+/* Opens device `index` of clu_list_devices: its context and profiling queue. Returns 0, or
+ * 1 on an OpenCL failure with a message in err. */
+int clu_device_open_index(int index, VbDevice *d, char *err, size_t errlen);
+
+/* Opens the one device chosen by spec (clu_device_pick with one item). Returns 0, 2 when
+ * spec matches nothing (usage error), or 1 on an OpenCL failure (err says which). */
 int clu_device_open(const char *spec, VbDevice *d, char *err, size_t errlen);
 void clu_device_close(VbDevice *d);
+
+/* Opens every device spec names (clu_device_pick), at most max, into devs[0..*ndev).
+ * Returns as clu_device_open; on failure none is left open. */
+int clu_devices_open(const char *spec, VbDevice *devs, int max, int *ndev, char *err,
+                     size_t errlen);
+void clu_devices_close(VbDevice *devs, int n);
 
 /* Builds source with options for d. A binary cache keyed by source, options and device
  * is used unless VBCL_CACHE_DIR is "off"; *cached says whether it was a cache hit and

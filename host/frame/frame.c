@@ -7,42 +7,48 @@
 #include <stdlib.h>
 #include <string.h>
 
-int frame_init(Frame *fr, VbDevice *dev, const Scene *s, RenderStats *st, char *err, size_t errlen)
+int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
+               size_t errlen)
 {
-    memset(&fr->aa, 0, sizeof fr->aa);
-    return renderer_init(&fr->r, dev, s, NULL, st, err, errlen);
-}
-
-static void progress_report(double t_start, long done, long total, int *shown)
-{
-    double el = clu_now_ms() - t_start;
-    if (el < 1000.0 && !*shown) return;
-    double eta = done > 0 ? el * (double)(total - done) / (double)done : 0.0;
-    fprintf(stderr, "\rvbcl: rendering %3.0f%%  (%.1f s elapsed, about %.1f s left) ",
-            100.0 * (double)done / (double)total, el / 1000.0, eta / 1000.0);
-    *shown = 1;
-}
-
-/* Pass 0: one ray through the centre of each pixel, tile by tile, into rgba. */
-static int frame_pixel_centres(Renderer *r, const Scene *s, float *rgba, RenderStats *st,
-                               int progress, char *err, size_t errlen)
-{
-    long npix = (long)s->width * s->height;
-    double t_start = clu_now_ms();
-    int shown = 0;
-    for (long first = 0; first < npix; first += r->tile_pixels) {
-        int n = (int)((npix - first) < r->tile_pixels ? (npix - first) : r->tile_pixels);
-        if (renderer_trace_tile(r, first, n, rgba, st)) {
-            if (shown) fputc('\n', stderr);
-            snprintf(err, errlen, "%s: %s", r->dev->name, clu_error());
-            return 1;
-        }
-        if (progress) progress_report(t_start, first + n, npix, &shown);
+    memset(fr, 0, sizeof *fr);
+    for (int i = 0; i < ndev && i < CLU_MAX_DEVICES; i++) {
+        snprintf(fr->work[i].name, sizeof fr->work[i].name, "%s", devs[i].name);
+        fr->work[i].index = devs[i].index;
     }
-    if (shown)
-        fprintf(stderr, "\rvbcl: rendering 100%% (%.1f s)%30s\n", (clu_now_ms() - t_start) / 1000.0,
-                "");
-    return 0;
+    int rc = renderer_init(&fr->r, &devs[0], s, NULL, st, err, errlen);
+    if (rc || ndev < 2) return rc;
+    fr->more = calloc((size_t)(ndev - 1), sizeof *fr->more);
+    if (!fr->more) {
+        snprintf(err, errlen, "out of memory");
+        return 1;
+    }
+    for (int i = 1; i < ndev && !rc; i++) {
+        RenderStats scratch; /* --stats reports the first device's build */
+        memset(&scratch, 0, sizeof scratch);
+        rc = renderer_init(&fr->more[i - 1], &devs[i], s, NULL, &scratch, err, errlen);
+        if (!rc) fr->nmore = i;
+    }
+    return rc;
+}
+
+Renderer *frame_renderer(Frame *fr, int i)
+{
+    return i == 0 ? &fr->r : &fr->more[i - 1];
+}
+
+int frame_devices(const Frame *fr)
+{
+    return 1 + fr->nmore;
+}
+
+int frame_pixel_centres(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int progress,
+                        char *err, size_t errlen)
+{
+    Renderer *rs[CLU_MAX_DEVICES];
+    int n = frame_devices(fr);
+    for (int i = 0; i < n; i++) rs[i] = frame_renderer(fr, i);
+    return tiles_trace(rs, n, fr->tiles, (long)s->width * s->height, rgba, st, fr->work, progress,
+                       err, errlen);
 }
 
 int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int progress, char *err,
@@ -55,10 +61,14 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
     free(fr->aa.levels_host);
     free(fr->aa.leaves_host);
     fr->aa.levels_host = fr->aa.leaves_host = NULL;
+    RenderStats before = *st; /* refinement and supersampling: the first device's work */
+    double t_first = t_start;
     if (s->ssaa > 1) {
         rc = aa_supersample(&fr->aa, &fr->r, s, s->ssaa, rgba, st, err, errlen);
     } else {
-        rc = frame_pixel_centres(&fr->r, s, rgba, st, progress, err, errlen);
+        rc = frame_pixel_centres(fr, s, rgba, st, progress, err, errlen);
+        before = *st;
+        t_first = clu_now_ms();
         st->samples = (unsigned long long)npix;
         st->samples_max = 1;
         unsigned long long centres = st->rays_primary;
@@ -68,6 +78,9 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
         st->rays_primary = centres;
     }
     st->render_ms = clu_now_ms() - t_start;
+    fr->work[0].rays += tiles_rays(st) - tiles_rays(&before);
+    fr->work[0].kernel_ms += tiles_kernel_ms(st) - tiles_kernel_ms(&before);
+    fr->work[0].busy_ms += clu_now_ms() - t_first;
     return rc;
 }
 
@@ -80,4 +93,8 @@ void frame_release(Frame *fr)
 {
     aa_release(&fr->aa);
     renderer_release(&fr->r);
+    for (int i = 0; i < fr->nmore; i++) renderer_release(&fr->more[i]);
+    free(fr->more);
+    fr->more = NULL;
+    fr->nmore = 0;
 }

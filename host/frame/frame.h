@@ -6,15 +6,33 @@
 
 #include "aa.h"
 #include "render.h"
+#include "tiles.h"
 
-/* A scene prepared for rendering on one device, and the anti-aliasing state it grows. */
+/* A scene prepared for rendering on one or more devices, and the anti-aliasing state it
+ * grows. Pass 0 runs on every device (tiles.h); refinement and supersampling run on the
+ * first device's renderer r. */
 typedef struct Frame {
     Renderer r;
     AaState aa;
+    Renderer *more; /* the other devices' renderers (nmore of them) */
+    int nmore;
+    const TileSource *tiles;          /* where pass 0's tiles come from: NULL, this process */
+    DeviceWork work[CLU_MAX_DEVICES]; /* [0]: r's device, then more[]'s */
 } Frame;
 
-/* Prepares s on dev (grid, program, buffers: renderer_init). Returns as renderer_init. */
-int frame_init(Frame *fr, VbDevice *dev, const Scene *s, RenderStats *st, char *err, size_t errlen);
+/* Prepares s on devs[0..ndev) (grid, program, buffers on each: renderer_init; st gets the
+ * first device's build). Returns as renderer_init. */
+int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
+               size_t errlen);
+
+/* Pass 0 alone: one ray through the centre of each pixel, tile by tile on every device
+ * (tiles from fr->tiles), into rgba. Returns 0, or 1 with a message in err. */
+int frame_pixel_centres(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int progress,
+                        char *err, size_t errlen);
+
+/* Renderer i of the frame (0: r, the first device's), and how many there are. */
+Renderer *frame_renderer(Frame *fr, int i);
+int frame_devices(const Frame *fr);
 
 /* Renders the whole image into rgba (width*height*4 floats, linear, row 0 at the top): one
  * ray through each pixel centre, then with s->aa_threshold > 0 adaptive refinement
