@@ -239,6 +239,97 @@ static void test_grid_matches_brute_force(void)
     compare_grid_brute("flat scene", flat, "[4, 1, 4], \"subgrid\": [8, 1, 8]", 50000);
 }
 
+/* grid_cell_box_range: for random boxes in random top cells (mostly inside the cell, some
+ * crossing its faces, some flat), the leaves it gives hold every triangle of the cell that
+ * overlaps the box within the cell (exact test on the host), only triangles of the cell, and
+ * fewer than the whole list where the cell has a sub-grid and the box is small. */
+static void test_grid_cell_box_range(void)
+{
+    static const char *json =
+        "{" CAM "\"render\": {\"grid\": 3}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"
+        "{\"shape\": \"box\", \"size\": [6, 0.2, 6], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}";
+    Fixture fx;
+    if (fixture_open(&fx, json)) return;
+    const Grid *g = &fx.r.grid;
+    enum { NQ = 2000 };
+    cl_uint ntris = fx.s.mesh.ntris, nq = NQ;
+    float *q = calloc(12 * NQ, sizeof *q);
+    unsigned char *mark = calloc((size_t)NQ * ntris, 1);
+    unsigned seed = 4242u;
+    for (int i = 0; i < NQ; i++) {
+        float *p = q + 12 * i;
+        for (int a = 0; a < 3; a++) {
+            int c = (int)(frand(&seed) * g->n[a]);
+            p[a] = (float)(c < g->n[a] ? c : g->n[a] - 1);
+            float lo = g->lo[a] + p[a] * g->cell[a];
+            float u = frand(&seed) * 1.2f - 0.1f, w = (i % 7 == 0) ? 0.0f : 0.3f * frand(&seed);
+            p[4 + a] = lo + u * g->cell[a];
+            p[8 + a] = lo + (u + w) * g->cell[a];
+        }
+    }
+    cl_mem mf = buffer(&fx.r.frame_host, sizeof fx.r.frame_host), mq = buffer(q, 12 * NQ * 4);
+    cl_mem mm = buffer(mark, (size_t)NQ * ntris);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem),  sizeof(cl_mem),  sizeof(cl_mem),
+                         sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_uint), sizeof(cl_mem)};
+    const void *v[] = {
+        &mf, &fx.r.buf.grid_cells, &fx.r.buf.leaf_start, &fx.r.buf.leaf_tris, &mq, &nq, &ntris,
+        &mm};
+    run_kernel(fx.r.program, "probe_grid_box_range", NQ, 8, sz, v);
+    read_buffer(mm, mark, (size_t)NQ * ntris);
+    int missing = 0, foreign = 0, restricted = 0, crowded = 0;
+    for (int i = 0; i < NQ; i++) {
+        const float *p = q + 12 * i;
+        uint32_t c =
+            (uint32_t)p[0] + (uint32_t)g->n[0] * ((uint32_t)p[1] + g->n[1] * (uint32_t)p[2]);
+        float centre[3], half[3];
+        int empty = 0;
+        for (int a = 0; a < 3; a++) { /* the box within the cell */
+            float lo = g->lo[a] + p[a] * g->cell[a], hi = lo + g->cell[a];
+            float b0 = fmaxf(p[4 + a], lo), b1 = fminf(p[8 + a], hi);
+            empty |= b0 > b1;
+            centre[a] = 0.5f * (b0 + b1);
+            half[a] = 0.5f * (b1 - b0);
+        }
+        uint32_t in_list = 0, marked = 0;
+        for (uint32_t t = 0; t < ntris; t++) {
+            int listed = 0;
+            for (uint32_t k = g->cell_start[c]; k < g->cell_start[c + 1] && !listed; k++)
+                listed = g->cell_tris[k] == t;
+            in_list += listed;
+            marked += mark[(size_t)i * ntris + t];
+            foreign += mark[(size_t)i * ntris + t] && !listed;
+            if (!listed || empty || mark[(size_t)i * ntris + t]) continue;
+            float tri[3][3];
+            for (int k = 0; k < 3; k++) {
+                vec3 pt = fx.s.mesh.verts[fx.s.mesh.tris[3 * t + (uint32_t)k]];
+                tri[k][0] = pt.x, tri[k][1] = pt.y, tri[k][2] = pt.z;
+            }
+            if (grid_tri_box_overlap(centre, half, tri) && ++missing <= 5)
+                CHECK(0, "query %d: triangle %u overlaps the box in cell %u but was not visited", i,
+                      t, c);
+        }
+        int n[3];
+        grid_sub_unpack(g->cells[2 * c + 1], n);
+        crowded += n[0] * n[1] * n[2] > 1;
+        restricted += n[0] * n[1] * n[2] > 1 && marked < in_list;
+    }
+    fprintf(stderr,
+            "    %d queries: %d in cells with a sub-grid, %d of them visiting part of the "
+            "list; %d triangles missed, %d from other cells\n",
+            NQ, crowded, restricted, missing, foreign);
+    CHECK(missing == 0 && foreign == 0, "%d triangles missed, %d foreign", missing, foreign);
+    CHECK(crowded > NQ / 10 && restricted > crowded / 2,
+          "the boxes restrict too rarely: %d of %d queries in sub-grids", restricted, crowded);
+    clReleaseMemObject(mf);
+    clReleaseMemObject(mq);
+    clReleaseMemObject(mm);
+    free(q);
+    free(mark);
+    fixture_close(&fx);
+}
+
 /* A glass box standing on an opaque floor: its bottom face lies in the floor's plane.
  * Rays from inside the glass toward the bottom meet both at the same distance up to
  * rounding; the floor, the surface in contact with the glass, must win every time, in the
@@ -453,6 +544,7 @@ void suite_kernels(void)
     RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
+    RUN_TEST(test_grid_cell_box_range);
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
