@@ -647,6 +647,25 @@ oom:
     return -1;
 }
 
+int grid_build_levels(Grid *g, const Mesh *m, const int res[3], float density, const int sub[3],
+                      float sub_density, char *err, size_t errlen)
+{
+    int one_level = sub && sub[0] == 1 && sub[1] == 1 && sub[2] == 1;
+    int rc;
+    if (one_level)
+        rc = grid_build(g, m, res, density, err, errlen);
+    else
+        rc = grid_build_tuned(g, m, res, density > 0.0f ? density : GRID_TOP_DEFAULT_DENSITY, 0.0f,
+                              GRID_AUTO_MAX_CELLS, err, errlen);
+    if (rc) return rc;
+    if (grid_build_leaves(g, m, sub, sub_density, err, errlen)) {
+        grid_free(g);
+        return -1;
+    }
+    g->build_ms += g->leaves_ms;
+    return 0;
+}
+
 void grid_free(Grid *g)
 {
     free(g->cell_start);

@@ -19,7 +19,8 @@
 
 /* The second level. A top cell's sub-grid resolution is packed into one word, 10 bits per
  * axis (grid_sub_pack); 1x1x1 means the cell's plain list. */
-#define GRID_SUB_DEFAULT_DENSITY 2.0f /* sub-cells per triangle of a crowded top cell */
+#define GRID_TOP_DEFAULT_DENSITY 0.125f /* top cells per triangle of a two-level `auto` */
+#define GRID_SUB_DEFAULT_DENSITY 2.0f   /* sub-cells per triangle of a crowded top cell */
 #define GRID_SUB_MIN_TRIS        8    /* `auto` leaves a top cell with fewer triangles a list */
 #define GRID_SUB_MAX_AXIS        64   /* most sub-cells per axis of one top cell */
 #define GRID_MAX_LEAVES          (1u << 27) /* most leaves (sub-cells and lists) in all */
@@ -109,6 +110,16 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
  * 2^32-1 references); on failure the second level holds no memory. */
 int grid_build_leaves(Grid *g, const Mesh *m, const int sub_res[3], float density, char *err,
                       size_t errlen);
+
+/* The grid a scene renders with: both levels. sub NULL (or any sub[i] <= 0) is auto, as in
+ * grid_build_leaves. With sub-grids (sub not 1,1,1), `auto` (res NULL or any res[i] <= 0)
+ * is a coarse top level: the density estimate alone (grid_auto_resolution with `density`
+ * cells per triangle, GRID_TOP_DEFAULT_DENSITY when density <= 0), the sub-grids taking the
+ * crowding; with sub = 1,1,1 (one level) it is grid_build's `auto`, refined by occupancy from
+ * `density` (GRID_DEFAULT_DENSITY when <= 0). A given res is used as given. Returns as
+ * grid_build; g->build_ms covers both levels. */
+int grid_build_levels(Grid *g, const Mesh *m, const int res[3], float density, const int sub[3],
+                      float sub_density, char *err, size_t errlen);
 
 /* Frees the arrays and zeroes the grid; safe on a zeroed or failed grid. */
 void grid_free(Grid *g);

@@ -60,12 +60,12 @@ static int renderer_build(Renderer *r, const Scene *s, const char *extra_options
     char gerr[256];
     const int *res = (s->grid_res[0] > 0) ? s->grid_res : NULL;
     const int *sub = (s->subgrid_res[0] > 0) ? s->subgrid_res : NULL;
-    if (grid_build(&r->grid, &s->mesh, res, s->grid_density, gerr, sizeof gerr) ||
-        grid_build_leaves(&r->grid, &s->mesh, sub, s->subgrid_density, gerr, sizeof gerr)) {
+    if (grid_build_levels(&r->grid, &s->mesh, res, s->grid_density, sub, s->subgrid_density, gerr,
+                          sizeof gerr)) {
         snprintf(err, errlen, "%s: grid: %s", s->path, gerr);
         return 2;
     }
-    st->grid_ms = r->grid.build_ms + r->grid.leaves_ms;
+    st->grid_ms = r->grid.build_ms;
     r->features = features_of_scene(s);
     st->features = r->features;
     features_build_options(r->features, s, extra_options, st->options, sizeof st->options);

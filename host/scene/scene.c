@@ -229,7 +229,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
-    s->grid_density = GRID_DEFAULT_DENSITY;
+    s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
     s->subgrid_density = GRID_SUB_DEFAULT_DENSITY;
     s->shadow_samples = 16;
     memcpy(s->ambient, amb, sizeof amb);
@@ -246,8 +246,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
     if (json_get_int(c, j, "render", "max_depth", 1, 64, 6, 0, &s->max_depth) ||
-        json_get_float(c, j, "render", "grid_density", 0.01, 64, GRID_DEFAULT_DENSITY, 0,
-                       &s->grid_density) ||
+        json_get_float(c, j, "render", "grid_density", 0.01, 64, 0.0, 0, &s->grid_density) ||
         json_get_float(c, j, "render", "subgrid_density", 0.01, 64, GRID_SUB_DEFAULT_DENSITY, 0,
                        &s->subgrid_density) ||
         json_get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
