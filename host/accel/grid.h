@@ -21,8 +21,8 @@
  * axis (grid_sub_pack); 1x1x1 means the cell's plain list. */
 #define GRID_TOP_DEFAULT_DENSITY 0.125f /* top cells per triangle of a two-level `auto` */
 #define GRID_SUB_DEFAULT_DENSITY 2.0f   /* sub-cells per triangle of a crowded top cell */
-#define GRID_SUB_MIN_TRIS        8    /* `auto` leaves a top cell with fewer triangles a list */
-#define GRID_SUB_MAX_AXIS        64   /* most sub-cells per axis of one top cell */
+#define GRID_SUB_MIN_TRIS        8      /* `auto` leaves a top cell with fewer triangles a list */
+#define GRID_SUB_MAX_AXIS        64     /* most sub-cells per axis of one top cell */
 #define GRID_MAX_LEAVES          (1u << 27) /* most leaves (sub-cells and lists) in all */
 
 typedef struct Grid {

@@ -61,7 +61,7 @@ typedef struct Scene {
     float fov; /* vertical, degrees */
     /* render */
     int max_depth;
-    int grid_res[3]; /* all 0: auto */
+    int grid_res[3];    /* all 0: auto */
     float grid_density; /* cells per triangle of `auto`; 0: the default (grid_build_levels) */
     int subgrid_res[3]; /* the second level's resolution in every crowded cell; all 0: auto */
     float subgrid_density;
