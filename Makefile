@@ -39,7 +39,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz
+.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz FORCE
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -109,7 +109,7 @@ run: vbcl
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0)
 # Then every benchmark part on tiny images (scripts/bench.py --quick), so that `make bench`
 # cannot rot; not in sanitizer builds, whose timings mean nothing.
-test: $(BUILD)/vbcl-tests $(BUILD)/vbcl
+test: $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
 	$(Q)scripts/bench.py --quick --vbcl $(BUILD)/vbcl --out $(BUILD)/bench-quick > $(BUILD)/bench-quick.log 2>&1 \
@@ -119,11 +119,38 @@ endif
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
 # figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
-# band counts, kernel build time. CSV, markdown and PNG in bench-out/. BENCH_FLAGS passes
-# options, e.g. BENCH_FLAGS="--parts grid --size 200".
+# band counts, kernel build time, rays per second against Embree. CSV, markdown and PNG in
+# bench-out/. BENCH_FLAGS passes options, e.g. BENCH_FLAGS="--parts grid --size 200".
 BENCH_FLAGS ?=
+# Embree, for the part "embree", is installed here (install-deps.sh --bench); where it cannot
+# be, that part measures vbcl alone.
 bench: vbcl
+	$(Q)scripts/install-deps.sh --bench || echo "bench: Embree not installed: part embree measures vbcl alone"
+	$(Q)$(MAKE) --no-print-directory $(BUILD)/vbcl-bench-rays
 	scripts/bench.py $(BENCH_FLAGS)
+
+# The ray-throughput bench against Embree (bench.py part "embree"; docs/benchmarks.md): the
+# probe kernels and Embree 3's single-ray API on the same rays. It links Embree when
+# embree3/rtcore.h is found (scripts/install-deps.sh --bench installs Debian's libembree-dev),
+# else it measures vbcl alone and says Embree was skipped. The renderer never links Embree.
+EMBREE = $(shell $(CC) -E -x c -include embree3/rtcore.h /dev/null >/dev/null 2>&1 && echo 1)
+BENCH_EMBREE_OBJ = $(BUILD)/tests/bench/bench_embree$(if $(EMBREE),-embree).o
+$(BUILD)/tests/bench/bench_embree-embree.o: tests/bench/bench_embree.c build/config.mk
+	@mkdir -p $(dir $@)
+	@echo "  CC      $< (with Embree)"
+	$(Q)$(CC) $(CPPFLAGS) -DVBCL_HAVE_EMBREE $(CFLAGS) -c -o $@ $<
+
+# embree.cfg changes when Embree appears or goes, so that the bench is linked again.
+$(BUILD)/tests/bench/embree.cfg: FORCE
+	@mkdir -p $(dir $@)
+	$(Q)echo "embree=$(EMBREE)" | cmp -s - $@ || echo "embree=$(EMBREE)" > $@
+
+$(BUILD)/vbcl-bench-rays: $(BUILD)/tests/bench/bench_rays.o $(BENCH_EMBREE_OBJ) $(LIB_OBJ) \
+                          $(BUILD)/tests/bench/embree.cfg
+	@echo "  LINK    $@$(if $(EMBREE),, (without Embree: not installed))"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LDLIBS) $(if $(EMBREE),-lembree3) -lpthread
+
+FORCE:
 
 # Render time against the auto-grid density (docs/architecture.md, "Measurements").
 bench-grid: vbcl
@@ -186,7 +213,7 @@ fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
 	done
 
 FORMAT_FILES := $(wildcard host/*.c host/*.h host/*/*.c host/*/*.h host/*/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \
-                tests/stress/*.c tests/fuzz/*.c tests/fuzz/*.h scripts/*.c)
+                tests/stress/*.c tests/bench/*.c tests/bench/*.h tests/fuzz/*.c tests/fuzz/*.h scripts/*.c)
 format:
 	clang-format -i $(FORMAT_FILES)
 

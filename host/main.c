@@ -52,13 +52,15 @@ static const char usage_text[] =
     "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
     "      --fresnel exact|thesis  energy split at interfaces: Fresnel, or thesis eq. 9\n"
     "      --exposure STOPS     scale the image by 2^STOPS before writing\n"
-    "      --aa THRESHOLD       adaptive anti-aliasing: refine pixels whose contrast\n"
-    "                           |a-b|/(a+b) with a neighbour exceeds THRESHOLD (0..1; 0 off)\n"
-    "      --aa-max-level L     deepest refinement, 2^L x 2^L samples per pixel (1..4)\n"
+    "      --aa THRESHOLD       adaptive anti-aliasing: split pixels and subpixels whose\n"
+    "                           contrast |a-b|/(a+b) with an adjacent one exceeds THRESHOLD\n"
+    "                           (0..1; 0 off)\n"
+    "      --aa-max-level L     deepest refinement, 2^L x 2^L subpixels per pixel (1..4)\n"
+    "      --aa-floor F         contrast of dark pairs: a+b counts as at least F (0..2)\n"
     "      --bands N|thesis     wavelength bands of a dispersive refraction (1..64), or the\n"
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
-    "      --aa-map FILE        write each pixel's refinement level as a heat map\n"
+    "      --aa-map FILE        write each pixel's deepest refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
     "      --device INDEX|NAME  OpenCL device (also VBCL_DEVICE; default: device 0)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
@@ -79,7 +81,7 @@ typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
-    double grid_density, subgrid_density, exposure, min_weight, aa;
+    double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor;
     int have_exposure;
     int list_devices, stats, quiet;
 } Options;
@@ -146,6 +148,7 @@ static const OptionSpec option_specs[] = {
     {"--min-weight", NULL, OPT_DOUBLE, offsetof(Options, min_weight), 0, 1},
     {"--aa", NULL, OPT_DOUBLE, offsetof(Options, aa), 0, 1},
     {"--aa-max-level", NULL, OPT_INT, offsetof(Options, aa_max_level), 1, VBCL_AA_MAX_LEVEL},
+    {"--aa-floor", NULL, OPT_DOUBLE, offsetof(Options, aa_floor), 0, 2},
     {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
     {"--aa-map", NULL, OPT_STRING, offsetof(Options, aa_map), 0, 0},
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
@@ -238,7 +241,7 @@ static int parse_args(int argc, char **argv, Options *o)
 {
     memset(o, 0, sizeof *o);
     o->width = o->height = o->shadow_samples = o->depth = -1;
-    o->grid_density = o->subgrid_density = o->min_weight = o->aa = -1;
+    o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
     o->aa_max_level = o->ssaa = o->bands = -1;
     o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
@@ -349,6 +352,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->depth > 0) s->max_depth = o->depth;
     if (o->min_weight >= 0) s->min_weight = (float)o->min_weight;
     if (o->aa >= 0) s->aa_threshold = (float)o->aa;
+    if (o->aa_floor >= 0) s->aa_floor = (float)o->aa_floor;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
     if (o->bands >= 0) {
         s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;

@@ -1,7 +1,8 @@
 #line 2 "probe.cl"
-/* probe.cl — kernels for the tests only (built with -DVBCL_TEST_KERNELS): brute-force
- * closest hit, the layout of the shared structs as the device sees it, and local
- * shading at arbitrary points for analytic checks. */
+/* probe.cl — kernels for the tests and the ray-throughput bench only (built with
+ * -DVBCL_TEST_KERNELS, never in a render): brute-force closest hit, the layout of the shared
+ * structs as the device sees it, local shading at arbitrary points for analytic checks, and
+ * the renderer's tracing and shading on rays the bench picks (tests/bench/bench_rays.c). */
 #ifndef VBCL_PROBE_CL
 #define VBCL_PROBE_CL
 
@@ -155,6 +156,264 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
         }
     }
     *count = k;
+}
+#endif
+
+/* ---- The ray-throughput bench (tests/bench/bench_rays.c, `make bench` part "embree") ----
+ * Each kernel runs the renderer's own device functions on rays the bench picks, so that a
+ * change to the traversal or to the shading path's feelers is measured without editing the
+ * bench. Point lists hold indices of primary rays whose first interfaces (hits, media) came
+ * from scene_intersect_closest, as in a frame. */
+
+/* rays -> hits: the closest hit of each ray through the grid (scene_trace_closest). */
+__kernel void probe_trace_closest(SCENE_KERNEL_ARGS __global const VbRay *rays, int nrays,
+                                  __global VbHit *hits)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    DevScene sc = DEV_SCENE;
+    VbRay r = rays[i];
+    TraceCount tc = {0, 0};
+    hits[i] = scene_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+}
+
+/* rays -> 1 where something lies on the ray before tmax (scene_trace_any), else 0. */
+__kernel void probe_trace_any(SCENE_KERNEL_ARGS __global const VbRay *rays, int nrays,
+                              __global uchar *blocked)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    DevScene sc = DEV_SCENE;
+    VbRay r = rays[i];
+    TraceCount tc = {0, 0};
+    blocked[i] = (uchar)scene_trace_any(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+}
+
+/* The shading point at the first interface of primary ray i, as light_sample_shading makes
+ * it; 0 when the ray left the scene. */
+VB_INLINE int probe_primary_point(const DevScene *sc, __global const VbRay *rays,
+                                  __global const VbHit *hits, __global const VbMedium *media, int i,
+                                  ShadePoint *sp)
+{
+    VbHit h = hits[i];
+    if (h.tri < 0) return 0;
+    VbRay r = rays[i];
+    float3 dir = vb_load3(r.dir);
+#ifdef VBCL_HAS_MEDIA
+    VbMedium before = media[i];
+    uint material = medium_cross(sc, h.tri, dir, before).surface;
+#else
+    (void)media;
+    VbMedium before = {-1, 0u};
+    uint material = scene_tri_material(sc, h.tri);
+#endif
+    *sp = shade_point_make(sc, dir, h, sample_key(sc->f, r.sample), before, material);
+    return 1;
+}
+
+/* rays, hits, media -> the material of each first interface's surface, or -1: a miss. */
+__kernel void probe_hit_surface(SCENE_KERNEL_ARGS __global const VbRay *rays,
+                                __global const VbHit *hits, __global const VbMedium *media,
+                                int nrays, __global int *surface)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    DevScene sc = DEV_SCENE;
+    ShadePoint sp;
+    surface[i] = probe_primary_point(&sc, rays, hits, media, i, &sp) ? (int)sp.material : -1;
+}
+
+/* points -> feelers traced (ShadowCount.traced) and radiance: the renderer's local shading
+ * of each point with its shadow feelers, light_shade_local as light_sample_shading runs it. */
+__kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
+                                  __global const VbHit *hits, __global const VbMedium *media,
+                                  __global const uint *points, int npoints, __global uint *traced,
+                                  __global float *radiance)
+{
+    int j = get_global_id(0);
+    if (j >= npoints) return;
+    DevScene sc = DEV_SCENE;
+    ShadePoint sp;
+    float3 col = (float3)(0.0f);
+    TraceCount tc = {0, 0};
+    ShadowCount shc = {0, 0};
+    if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
+        col = light_shade_local(&sc, &sp, &tc, &shc);
+    traced[j] = shc.traced;
+    vstore4((float4)(col, 0.0f), j, radiance);
+}
+
+VB_INLINE void probe_store_ray(__global VbRay *out, float3 org, float3 dir, float tmax, uint sample)
+{
+    VbRay r;
+    vstore3(org, 0, r.org);
+    vstore3(dir, 0, r.dir);
+    r.tmax = tmax;
+    r.sample = sample;
+    *out = r;
+}
+
+#ifdef VBCL_HAS_AREA_LIGHTS
+/* The feelers light_reflect_area traces toward a light of radius r > 0 whose centre is to_c
+ * away (d2, d: its squared length and length), in its order; returns how many. */
+VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, float3 origin,
+                                float3 to_c, float d2, float d, float r, uint key, uint sample,
+                                __global VbRay *out)
+{
+    uint strata = sc->f->shadow_strata;
+    int jitter = !(sc->f->flags & VBCL_FRAME_FIXED_FEELERS);
+    float3 wc = to_c / d;
+    if (dot(sp->ng, wc) < -(r / d)) return 0;
+    float one_minus_cos = light_cap_solid_angle(r, d) * (1.0f / (2.0f * VB_PI));
+    float3 tx, ty;
+    vb_frame(wc, &tx, &ty);
+    int k = 0;
+    for (uint i = 0; i < strata; i++)
+        for (uint j = 0; j < strata; j++) {
+            float3 w = light_cap_direction(i, j, strata, key, jitter, one_minus_cos, tx, ty, wc);
+            if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
+            float b = dot(w, to_c);
+            float disc = fmax(0.0f, b * b - (d2 - r * r));
+            probe_store_ray(out + k++, origin, w, b - sqrt(disc), sample);
+        }
+    return k;
+}
+#endif
+
+/* The feelers light_shade_local traces at sp (light_reflect_one for each light, in its
+ * order: origin, direction and distance to the light), from out[0] on; returns how many.
+ * It repeats light.cl's sampling; the bench checks that the counts equal ShadowCount.traced. */
+VB_INLINE int probe_point_feelers(const DevScene *sc, const ShadePoint *sp, uint sample,
+                                  __global VbRay *out)
+{
+    int k = 0;
+    for (uint l = 0; l < sc->f->nlights; l++) {
+        __global const VbLight *light = sc->lights + l;
+        uint key = vb_hash(sp->key * 0x27d4eb2fu + l);
+        float3 to_c = vb_gload3(light->centre) - sp->p;
+        float d2 = dot(to_c, to_c);
+        float d = sqrt(d2);
+        float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
+#ifdef VBCL_HAS_AREA_LIGHTS
+        if (light->radius > 0.0f) {
+            if (d > light->radius * 1.0001f)
+                k += probe_cap_feelers(sc, sp, origin, to_c, d2, d, light->radius, key, sample,
+                                       out + k);
+            continue;
+        }
+#else
+        (void)key;
+#endif
+        float3 w = to_c / d;
+        if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
+        probe_store_ray(out + k++, origin, w, d, sample);
+    }
+    return k;
+}
+
+/* points, offsets -> the feelers of point j from feelers[offsets[j]] on (sample: the point's
+ * primary ray), and written[j]: how many. */
+__kernel void probe_feeler_rays(SCENE_KERNEL_ARGS __global const VbRay *rays,
+                                __global const VbHit *hits, __global const VbMedium *media,
+                                __global const uint *points, int npoints,
+                                __global const uint *offsets, __global VbRay *feelers,
+                                __global uint *written)
+{
+    int j = get_global_id(0);
+    if (j >= npoints) return;
+    DevScene sc = DEV_SCENE;
+    ShadePoint sp;
+    int k = 0;
+    if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
+        k = probe_point_feelers(&sc, &sp, points[j], feelers + offsets[j]);
+    written[j] = (uint)k;
+}
+
+/* feelers (sample: the primary ray of their point), media of the primary rays -> steps, end:
+ * the walk light_feeler makes (with transparency, medium_shadow_transmittance's crossings
+ * from the point's medium; without, one trace): its closest-hit calls, and the distance
+ * along the feeler of the last one's hit, or -1 when the last one reached the light. */
+__kernel void probe_feeler_walk(SCENE_KERNEL_ARGS __global const VbRay *feelers, int n,
+                                __global const VbMedium *media, __global uint *steps,
+                                __global float *end)
+{
+    int i = get_global_id(0);
+    if (i >= n) return;
+    DevScene sc = DEV_SCENE;
+    VbRay r = feelers[i];
+    float3 org = vb_load3(r.org), dir = vb_load3(r.dir), o = org;
+    TraceCount tc = {0, 0};
+    float left = r.tmax;
+    uint k = 0;
+    float last = -1.0f;
+#ifdef VBCL_HAS_TRANSPARENCY
+    VbMedium state = media[r.sample];
+    float3 trans = (float3)(1.0f);
+    for (int guard = 0; guard < 1024; guard++) {
+        uint mb = medium_material(&sc, state);
+        VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);
+        k++;
+        if (h.tri < 0) break;
+        float3 p = tri_point(sc.tris, h);
+        last = dot(p - org, dir);
+        float seg = fmax(0.0f, dot(p - o, dir));
+        trans *= medium_absorb(&sc, mb, seg);
+        Crossing c = medium_cross(&sc, h.tri, dir, state);
+        float3 ng = tri_normal(sc.tris, h.tri);
+        if (c.interface) {
+            __global const VbMaterial *ms = sc.materials + c.surface;
+            if (ms->k_global <= 0.0f) break;
+            trans *= ms->k_global *
+                     medium_interface_transmit(&sc, dir, ng, c.mat_before, c.mat_after, -1);
+        }
+        if (vb_max3(trans) < 1e-7f) break;
+        last = -1.0f;
+        state = c.after;
+        left -= seg;
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc.tris, h.tri));
+    }
+#else
+    (void)media;
+    VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);
+    k = 1;
+    if (h.tri >= 0) last = dot(tri_point(sc.tris, h) - org, dir);
+#endif
+    steps[i] = k;
+    end[i] = last;
+}
+
+#ifdef VBCL_HAS_TRANSPARENCY
+/* points (primary rays whose first interface is a dielectric) -> the reflected and
+ * transmitted rays tree_spawn pushes there, as tree_trace_secondary starts a tree: two
+ * slots per point, tmax INFINITY, sample the point's primary ray or 0xffffffff (slot unused;
+ * with dispersion only the first two of the bands are kept). */
+__kernel void probe_secondary_rays(SCENE_KERNEL_ARGS __global const VbRay *rays,
+                                   __global const VbHit *hits, __global const VbMedium *media,
+                                   __global const uint *points, int npoints, __global VbRay *out)
+{
+    int j = get_global_id(0);
+    if (j >= npoints) return;
+    DevScene sc = DEV_SCENE;
+    int i = (int)points[j];
+    VbHit h = hits[i];
+    VbRay r = rays[i];
+    float3 dir = vb_load3(r.dir);
+    VbMedium before = media[i];
+    Crossing c = medium_cross(&sc, h.tri, dir, before);
+    ShadePoint sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, c.surface);
+    TreeRay stack[VB_TREE_STACK];
+    int n = 0;
+    TreeCount cnt = {0};
+    cnt.prune_budget = f->min_weight;
+    tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
+               -1, 0);
+    for (int k = 0; k < 2; k++) {
+        if (k < n)
+            probe_store_ray(out + 2 * j + k, stack[k].org, stack[k].dir, INFINITY, (uint)i);
+        else
+            probe_store_ray(out + 2 * j + k, (float3)(0.0f), (float3)(0.0f, 0.0f, 1.0f), 0.0f,
+                            0xffffffffu);
+    }
 }
 #endif
 

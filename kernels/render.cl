@@ -1,18 +1,21 @@
 #line 2 "render.cl"
 /* render.cl — the kernel entry points of a frame, run tile by tile:
  *   camera_generate_rays    frame              -> rays
- *   aa_generate_rays        frame, marks       -> rays (supersamples of listed pixels)
+ *   aa_generate_rays        frame              -> rays (--ssaa: supersamples of pixels)
  *   scene_intersect_closest rays               -> hits, media (first interface of each ray)
  *   light_sample_shading    rays, hits, media  -> radiance (k_local term, shadow feelers)
  *   tree_trace_secondary    rays, hits, media  -> radiance += (k_global term: the ray tree;
  *                                                 only with VBCL_HAS_TRANSPARENCY), splits
  *   tree_trace_bands        splits             -> radiance += the recorded dispersive
  *                                                 subtrees (only with VBCL_HAS_DISPERSION)
- *   aa_contrast_mark        film, levels       -> marks (pixels to refine; whole image)
- *   aa_reconstruct          radiance, marks    -> film, levels (box window per pixel)
+ *   aa_reconstruct          radiance           -> film (--ssaa: box window per pixel)
+ *   aa_contrast_mark        film, tree         -> marks (quadtree leaves to split)
+ *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
+ *   aa_split_store          radiance, marks    -> tree (four leaves for each split node)
+ *   aa_resolve              tree               -> film, info (mean of each pixel's leaves)
  * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
- * adds the pass and the list, with dispersion the tree kernels add the split records, the
- * other aa_* kernels take only their own buffers), are
+ * adds the pass, aa_split_rays the pass and the list, with dispersion the tree kernels add
+ * the split records, the other aa_* kernels take only their own buffers), are
  * thin — index, bounds guard, device functions — and the host concatenates these files. */
 
 #ifndef VBCL_RENDER_CL
@@ -311,17 +314,15 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
 #endif
 #endif
 
-/* frame, marks -> rays: side x side rays through the subpixel centres of each pixel of a
- * batch of listed pixels (complete stratification), ray i belonging to batch entry
- * i / side^2 and subpixel i % side^2 (row-major). */
-__kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
-                               __global const uint *marks)
+/* frame -> rays: uniform supersampling, side x side rays through the subpixel centres of
+ * each pixel of a batch of pixels from aa->first on (complete stratification), ray i
+ * belonging to pixel first + i / side^2 and subpixel i % side^2 (row-major). */
+__kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
     uint n = (uint)(aa->side * aa->side);
-    uint e = aa->first + (uint)i / n, sub = (uint)i % n;
-    uint pixel = aa->identity ? e : marks[e];
+    uint pixel = aa->first + (uint)i / n, sub = (uint)i % n;
     int x = (int)(pixel % (uint)f->width), y = (int)(pixel / (uint)f->width);
     float inv = 1.0f / (float)aa->side;
     float px = (float)x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
@@ -329,39 +330,129 @@ __kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     rays[i] = camera_ray(f, px, py, aa_sample_id(pixel, aa->side, sub));
 }
 
-/* film, levels -> marks, mark_counts: over the whole image, each pixel below the top
- * level against its 8 neighbours; a marked pixel at level l is appended to the list
- * segment of level l (mark_counts[l] counts it). */
-__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
-                               __global const int *levels, __global uint *marks,
-                               __global uint *mark_counts)
-{
-    int p = get_global_id(0);
-    if (p >= aa->width * aa->height) return;
-    int lv = levels[p];
-    if (lv >= aa->max_level) return;
-    if (aa_pixel_marked(aa, film, levels, p, lv)) {
-        uint k = atomic_inc(&mark_counts[lv]);
-        marks[aa->seg_offset[lv] + k] = (uint)p;
-    }
-}
-
-/* radiance, marks -> film (and levels): each pixel of a batch becomes the mean of its
- * side^2 samples — a box window over its own subpixels (thesis figure 4.4), so refining
- * a pixel changes no other pixel. */
-__kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const uint *marks,
-                             __global const float *radiance, __global float *film,
-                             __global int *levels)
+/* radiance -> film: uniform supersampling, each pixel of a batch the mean of its side^2
+ * samples (a box window over its own subpixels, thesis figure 4.4). */
+__kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float *radiance,
+                             __global float *film)
 {
     uint j = get_global_id(0);
     if (j >= aa->entries) return;
     uint n = (uint)(aa->side * aa->side);
-    uint e = aa->first + j;
-    uint pixel = aa->identity ? e : marks[e];
     float4 sum = (float4)(0.0f);
     for (uint k = 0; k < n; k++) sum += vload4(j * n + k, radiance);
-    vstore4(sum * (1.0f / (float)n), pixel, film);
-    if (aa->write_level) levels[pixel] = aa->level;
+    vstore4(sum * (1.0f / (float)n), aa->first + j, film);
+}
+
+/* film, slots, tree, changed -> marks, counts: over the whole image, every leaf below the
+ * top level against its adjacent leaves (aa_leaf_fails), in pixels whose neighbourhood
+ * changed last round; a failing leaf is appended to marks as (pixel, node code). counts[0]
+ * counts the marks, counts[1 + l] those at level l. */
+__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
+                               __global const int *slots, __global const float *tree,
+                               __global uint2 *marks, __global uint *counts,
+                               __global const int *changed)
+{
+    int p = get_global_id(0);
+    if (p >= aa->width * aa->height) return;
+    int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
+    if (!aa_pixel_dirty(aa, changed, x, y)) return;
+    if (slot < 0) {
+        float3 a = aa_display(aa, vload4(p, film).xyz);
+        int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
+        if (all_plain ? !fails
+                      : !aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE, y * AA_TREE_SIDE,
+                                       AA_TREE_SIDE, 0, a))
+            return;
+        uint m = atomic_inc(&counts[0]);
+        atomic_inc(&counts[1]);
+        marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
+        return;
+    }
+    for (int k = 0; k < VBCL_AA_CELLS; k++) {
+        float4 c = vload4((size_t)slot * VBCL_AA_CELLS + (size_t)k, tree);
+        int lv = (int)c.w, s = AA_TREE_SIDE >> lv;
+        int fx = k % AA_TREE_SIDE, fy = k / AA_TREE_SIDE;
+        if (lv >= aa->max_level || fx % s || fy % s) continue; /* not a leaf's first cell */
+        if (!aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE + fx, y * AA_TREE_SIDE + fy, s,
+                           lv, aa_display(aa, c.xyz)))
+            continue;
+        uint m = atomic_inc(&counts[0]);
+        atomic_inc(&counts[1 + lv]);
+        marks[m] = (uint2)((uint)p, aa_node_code(lv, fx / s, fy / s));
+    }
+}
+
+/* frame, marks -> rays: three rays per marked node of a batch, through the samples of the
+ * three children that do not hold the node's own sample (aa_tree.h): ray i belongs to
+ * mark first + i / 3. */
+__kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
+                            __global const uint2 *marks)
+{
+    int i = get_global_id(0);
+    if (i >= nrays) return;
+    uint2 m = marks[aa->first + (uint)i / 3u];
+    uint child = aa_new_child(m.y, i % 3);
+    int cell = aa_node_sample_cell(aa_node_level(child), aa_node_x(child), aa_node_y(child));
+    float2 at = aa_cell_position(cell);
+    int x = (int)(m.x % (uint)f->width), y = (int)(m.x / (uint)f->width);
+    rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,
+                         aa_sample_id(m.x, AA_TREE_SIDE, (uint)cell));
+}
+
+/* radiance, marks -> tree, slots, slot_pixels, changed: each marked node of a batch becomes
+ * four leaves one level deeper: the child holding the node's sample keeps its value, the
+ * other three take the new samples. A pixel split for the first time gets a tree slot
+ * (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them); every
+ * split pixel records the round in changed. */
+__kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2 *marks,
+                             __global const float *radiance, __global const float *film,
+                             __global int *slots, __global int *slot_pixels, __global float *tree,
+                             __global uint *counts, __global int *changed)
+{
+    uint j = get_global_id(0);
+    if (j >= aa->entries) return;
+    uint2 m = marks[aa->first + j];
+    int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
+    changed[m.x] = aa->round;
+    if (slot < 0) {
+        slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
+        slots[m.x] = slot;
+        slot_pixels[slot] = (int)m.x;
+    }
+    __global float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
+    if (lv == 1) {
+        aa_fill_node(cells, m.y, vload4(m.x, film).xyz, lv);
+    } else {
+        int s = AA_TREE_SIDE >> (lv - 1);
+        int ox = aa_node_x(m.y) * s, oy = aa_node_y(m.y) * s;
+        for (int y = oy; y < oy + s; y++)
+            for (int x = ox; x < ox + s; x++) cells[4 * (y * AA_TREE_SIDE + x) + 3] = (float)lv;
+    }
+    for (int k = 0; k < 3; k++)
+        aa_fill_node(cells, aa_new_child(m.y, k), vload4(3 * j + (uint)k, radiance).xyz, lv);
+}
+
+/* tree, slot_pixels -> film, info: each refined pixel becomes the area-weighted mean of its
+ * leaves (the mean of its cells: the box window of figure 4.4 over the pixel's own
+ * footprint), and info its deepest level | leaf count << 8. */
+__kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot_pixels,
+                         __global const float *tree, __global float *film, __global int *info)
+{
+    uint slot = get_global_id(0);
+    if (slot >= aa->entries) return;
+    __global const float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
+    float3 sum = (float3)(0.0f);
+    int deepest = 0, leaves = 0;
+    for (int k = 0; k < VBCL_AA_CELLS; k++) {
+        float4 c = vload4(k, cells);
+        int lv = (int)c.w, s = AA_TREE_SIDE >> lv;
+        sum += c.xyz;
+        deepest = max(deepest, lv);
+        leaves += (k % AA_TREE_SIDE) % s == 0 && (k / AA_TREE_SIDE) % s == 0;
+    }
+    int p = slot_pixels[slot];
+    vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
+    info[p] = deepest | leaves << 8;
 }
 
 #ifdef VBCL_TEST_KERNELS

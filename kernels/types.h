@@ -182,27 +182,26 @@ typedef struct VbGridCell {
 #define VBCL_GRID_SUB_MASK 1023u
 #define VBCL_GRID_LIST     (1u | 1u << VBCL_GRID_SUB_BITS | 1u << (2 * VBCL_GRID_SUB_BITS))
 
-/* Anti-aliasing (thesis 4.1.2): a pixel at refinement level L is the box-filtered mean of
- * 2^L x 2^L samples at its subpixel centres; level 0 is the single ray through its centre. */
-#define VBCL_AA_MAX_LEVEL 4 /* 16x16 subpixels, the thesis's bound */
+/* Anti-aliasing (thesis 4.1.2): each pixel is the root of a quadtree of subpixels down to
+ * level VBCL_AA_MAX_LEVEL (16x16); a leaf holds one sample, and the pixel is the
+ * area-weighted mean of its leaves (kernels/aa_tree.h). Level 0 is the ray through the
+ * pixel's centre. */
+#define VBCL_AA_MAX_LEVEL 4   /* 16x16 subpixels, the thesis's bound */
+#define VBCL_AA_CELLS     256 /* finest cells per pixel: (2^VBCL_AA_MAX_LEVEL)^2 */
 
 /* One step of the anti-aliasing passes (aa_* kernels in render.cl), uploaded before each
- * launch: the contrast test's parameters, or a batch of pixels to supersample. */
+ * launch: the contrast test's parameters, or a batch of nodes or pixels to sample. */
 typedef struct VbAaPass {
-    float threshold;          /* a pair of neighbours fails when |a-b| / (a+b) > threshold */
-    float contrast_scale;     /* values are scaled by 2^exposure and clamped to [0, 1] first */
-    int max_level;            /* pixels at this level are never marked */
-    int width, height;        /* image size in pixels */
-    int side;                 /* batch: samples per pixel axis (2^level, or N of --ssaa) */
-    int level;                /* batch: the level its pixels reach (written to the level map) */
-    unsigned int identity;    /* batch: 1 if list entry e is pixel e (uniform supersampling) */
-    unsigned int first;       /* batch: its first entry in the list of marked pixels */
-    unsigned int entries;     /* batch: pixels in it */
-    unsigned int write_level; /* batch: 1 to record the level (adaptive), 0 (uniform) */
-    unsigned int pad;
-    unsigned int seg_offset[VBCL_AA_MAX_LEVEL]; /* contrast: where the list of marked pixels
-                                                 * at level l starts (capacity: the number
-                                                 * of pixels at level l) */
+    float threshold;      /* a pair of neighbours fails when |a-b| / max(a+b, floor) > threshold */
+    float contrast_scale; /* values are scaled by 2^exposure and clamped to [0, 1] first */
+    int max_level;        /* nodes at this level are never split */
+    int width, height;    /* image size in pixels */
+    int side;             /* uniform batch: samples per pixel axis (N of --ssaa) */
+    float floor;          /* contrast: a + b below this counts as this (dark noise) */
+    unsigned int first;   /* batch: its first entry in the list of marked nodes (or pixels) */
+    unsigned int entries; /* batch: entries in it */
+    int round;            /* adaptive: the round (0, 1, ...) of this contrast pass or batch */
+    unsigned int pad[2];
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */
@@ -274,7 +273,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
     X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
-    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, seg_offset)) X(sizeof(VbSplit))    \
+    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
 /* clang-format on */
@@ -318,10 +317,10 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, after) == 80, split_after);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, key) == 100, split_key);
 VBCL_STATIC_ASSERT(sizeof(VbSplitSet) == 240, splitset_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplitSet, count) == 224, splitset_count);
-VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 64, aapass_size);
+VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 48, aapass_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
-VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 32, aapass_first);
-VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, seg_offset) == 48, aapass_seg_offset);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, floor) == 24, aapass_floor);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 28, aapass_first);
 
 /* The counter list's indices: distinct (their bits' sum equals their union), clear of the
  * reserved index 0 and below the by-depth counters. */

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""bench.py — `make bench`: the thesis's own measurements and ours, in four parts.
+"""bench.py — `make bench`: the thesis's own measurements and ours, in five parts.
 
   1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
               threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
@@ -9,10 +9,12 @@
               on scenes from about 100 to 184,000 triangles;
   3. error    run time against error (RMSE and PSNR against a converged reference) for
               anti-aliasing thresholds (scripts/bench_aa.py) and for band counts;
-  4. build    kernel build time, cold (empty binary cache) and warm, per feature set.
+  4. build    kernel build time, cold (empty binary cache) and warm, per feature set;
+  5. embree   Mrays/s per ray kind against Embree 3 on the same triangles and rays
+              (build/vbcl-bench-rays, tests/bench/bench_rays.c; vbcl alone without Embree).
 
-usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build] [--vbcl ./vbcl]
-                        [--out bench-out] [--size N] [--repeats N]
+usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build,embree] [--vbcl ./vbcl]
+                        [--out bench-out] [--size N] [--repeats N] [--bench-rays PATH]
 
 Writes OUT/<part>.csv, OUT/<part>.md and, for parts 2 and 3, OUT/<part>.png; OUT/bench.md
 collects the markdown tables with the machine and device they were measured on. Times come
@@ -303,7 +305,7 @@ def part_error(a, out):
         aa_rows = list(csv.DictReader(f))
     aa_text = write_table(out, "aa_time_error", aa_rows,
                           ["scene", "size", "method", "param", "render_ms",
-                           "samples_per_pixel", "rmse", "psnr_db"],
+                           "samples_per_pixel", "rmse", "psnr_db", "us_per_sample", "us_per_ray"],
                           "Run time against error: anti-aliasing",
                           "Against `--ssaa 16` of the same scene with another seed "
                           "(scripts/bench_aa.py).")
@@ -350,6 +352,72 @@ def part_build(a, out):
                        "Kernel build time, cold and warm", note)
 
 
+# Part 5: scenes traced by vbcl and Embree; each with --grid auto and, where it has one, the
+# scene's own grid (label, path).
+EMBREE_SCENES = [
+    ("A.4 two prisms", A4),
+    ("glass_bombed_sphere", "scenes/glass_bombed_sphere.json"),
+    ("spheres36", "scenes/bench/spheres36.json"),
+]
+
+
+def part_embree(a, out):
+    prog = a.bench_rays or next(
+        (p for p in (os.path.join(os.path.dirname(a.vbcl) or ".", "vbcl-bench-rays"),
+                     "build/vbcl-bench-rays") if os.path.exists(p)), None)
+    title = "Against Embree: Mrays/s per ray kind on the same triangles and rays"
+    if not prog:
+        text = f"### {title}\n\nskipped: build/vbcl-bench-rays not built (make bench builds it)\n"
+        print(text, flush=True)
+        return text
+    size = a.size or (16 if a.quick else 200)
+    reps = a.repeats_given or (1 if a.quick else 5)
+    rows, info = [], None
+    for label, scene in EMBREE_SCENES:
+        with open(scene) as f:
+            own = json.load(f).get("render", {}).get("grid")
+        grids = ([] if own is None else [None]) + ["auto"]
+        for g in grids:
+            path = os.path.join(a.tmp, "rays.json")
+            cmd = [prog, scene, "--width", str(size), "--height", str(size),
+                   "--repeats", str(reps), "--json", path]
+            cmd += ["--grid", g] if g else []
+            cmd += ["--shadow-samples", "4"] if a.quick else []
+            subprocess.run(cmd, check=True)  # fails when the two sides disagree
+            with open(path) as f:
+                info = json.load(f)
+            grid = g or f"{own} (scene)"
+            for k in info["kinds"]:
+                emb = "embree_mrays_s" in k
+                rows.append({
+                    "scene": label, "triangles": info["triangles"], "grid": grid,
+                    "cells": info["cells"], "kind": k["kind"], "rays": k["rays"],
+                    "vbcl_mrays_s": f"{k['vbcl_mrays_s']:.3f}" if k["rays"] else "",
+                    "embree_mrays_s": f"{k['embree_mrays_s']:.3f}" if emb else "",
+                    "vbcl/embree": f"{k['ratio']:.3f}" if emb else "",
+                    "vbcl_any_mrays_s": (f"{k['vbcl_any_mrays_s']:.3f}"
+                                         if "vbcl_any_mrays_s" in k and k["rays"] else ""),
+                    "agreement": f"{100 * k['agreement']:.3f}%" if emb else "",
+                })
+    note = (f"{size}x{size} camera rays, the scenes' feelers per point"
+            f"{' (4 with --quick)' if a.quick else ''}, median of {reps} interleaved repeats. "
+            f"vbcl: OpenCL event time of probe kernels running the renderer's own functions on "
+            f"{info['device']}; Embree: {info['embree']}, single-ray API"
+            f"{', RTC_SCENE_FLAG_ROBUST' if info['robust'] else ''}, {info['threads']} threads, "
+            "wall time, BVH build excluded. Kinds: primary (camera rays, closest hit); shadow "
+            "(feelers from opaque primary hits whose feelers meet no dielectric: the renderer's "
+            "light_shade_local against rtcOccluded1); shadow_glass (the other opaque primary hits' "
+            "feelers: light_shade_local against as many rtcIntersect1 from crossing to crossing as "
+            "the renderer's walk makes); secondary (reflected and transmitted rays from primary "
+            "hits on dielectrics, closest hit). vbcl_any: the shadow feelers by scene_trace_any "
+            "alone. agreement: rays on which both sides agree on hit or miss and the distance "
+            "(1e-4 relative).")
+    return write_table(out, "embree", rows,
+                       ["scene", "triangles", "grid", "cells", "kind", "rays", "vbcl_mrays_s",
+                        "embree_mrays_s", "vbcl/embree", "vbcl_any_mrays_s", "agreement"],
+                       title, note)
+
+
 def machine(vbcl):
     cpu = platform.processor() or platform.machine()
     try:
@@ -365,20 +433,24 @@ def machine(vbcl):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes: every part runs (CI)")
-    ap.add_argument("--parts", default="thesis,grid,error,build")
+    ap.add_argument("--parts", default="thesis,grid,error,build,embree")
     ap.add_argument("--vbcl", default="./vbcl")
     ap.add_argument("--out", default="bench-out")
     ap.add_argument("--size", type=int, default=0, help="image size of parts 1 and 2")
     ap.add_argument("--repeats", type=int, default=None,
                     help="runs per setting, median (default 3; --quick 1)")
+    ap.add_argument("--bench-rays", default=None,
+                    help="the part embree's program (default: beside --vbcl, else build/)")
     a = ap.parse_args()
+    a.repeats_given = a.repeats
     a.repeats = a.repeats or (1 if a.quick else 3)
     os.makedirs(a.out, exist_ok=True)
-    parts = {"thesis": part_thesis, "grid": part_grid, "error": part_error, "build": part_build}
+    parts = {"thesis": part_thesis, "grid": part_grid, "error": part_error, "build": part_build,
+             "embree": part_embree}
     chosen = [p.strip() for p in a.parts.split(",") if p.strip()]
     for p in chosen:
         if p not in parts:
-            ap.error(f"--parts: unknown part {p!r} (thesis, grid, error, build)")
+            ap.error(f"--parts: unknown part {p!r} ({', '.join(parts)})")
     report = [f"# vbcl benchmarks{' (--quick)' if a.quick else ''}", "",
               f"Measured {time.strftime('%Y-%m-%d')} on {machine(a.vbcl)}"]
     t_start = time.time()

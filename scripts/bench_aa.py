@@ -4,6 +4,7 @@ uniform (--ssaa N) supersampling, each against a converged --ssaa 16 reference o
 same scene (docs/architecture.md, "Measurements").
 
 usage: scripts/bench_aa.py [--quick] [--vbcl ./vbcl] [--out bench-out] [--repeats N]
+                          [--scenes NAME,...]
 
 Writes OUT/aa_time_error.csv (one row per render) and OUT/aa_time_error.png (RMSE against
 render time, one panel per scene). Time is the render's wall time from --stats-json (pass 0,
@@ -12,6 +13,10 @@ linear image clamped to [0, 1] (what a display shows), and PSNR = 20 log10(1 / R
 The reference is rendered with another render.seed, so that its shadow-feeler jitter is
 independent of the images measured (the adaptive mode's level-4 pixels would otherwise
 equal it exactly); its subpixel positions are the same 16x16 grid.
+Cost per sample: device time of the tracing kernels per camera ray (us), for adaptive
+refinement its own batches (aa.refine_ms / rays.refinement), for uniform all of them
+(time_ms.kernels / samples.total); and the same per traced ray, camera rays plus their
+shadow feelers and ray-tree rays (for refinement: the rays beyond those of the plain render).
 --quick renders tiny images (for CI: well under a minute).
 """
 import argparse
@@ -54,12 +59,14 @@ FULL = [
     ("scenes/quickstart.json", "quickstart (soft shadows)", 128, []),
     ("scenes/glass_bombed_sphere.json", "glass_bombed_sphere (ray trees)", 64,
      ["--shadow-samples", "4"]),
+    ("scenes/thesis/a4_two_prisms.json", "a4_two_prisms (thesis A.4, --grid auto)", 100,
+     ["--grid", "auto"]),
 ]
 QUICK = [
     ("tests/scenes/aa_edges.json", "aa_edges", 16, []),
     ("scenes/quickstart.json", "quickstart", 16, ["--shadow-samples", "1"]),
 ]
-THRESHOLDS_FULL = [1.0, 0.6, 0.4, 0.2, 0.1, 0.05, 0.02]
+THRESHOLDS_FULL = [1.0, 0.4, 0.2, 0.1, 0.05, 0.02]
 THRESHOLDS_QUICK = [1.0, 0.4, 0.1, 0.02]
 UNIFORM_FULL = [1, 2, 4, 8]
 UNIFORM_QUICK = [1, 2, 4]
@@ -101,11 +108,35 @@ def read_stats_json(vbcl, scene, opts, env=None):
         os.remove(path)
 
 
-def render(vbcl, scene, size, extra, opts, out):
-    """Renders scene at size x size into out; returns (render wall ms, samples per pixel)."""
+def render(vbcl, scene, size, extra, opts, out, full=False):
+    """Renders scene at size x size into out; returns (render wall ms, samples per pixel),
+    or with full the whole --stats-json document."""
     st = read_stats_json(vbcl, scene,
                          ["--width", str(size), "--height", str(size), "-o", out] + extra + opts)
-    return st["time_ms"]["render"], st["samples"]["per_pixel_mean"]
+    return st if full else (st["time_ms"]["render"], st["samples"]["per_pixel_mean"])
+
+
+def traced(st):
+    """Rays a render traced: camera rays, shadow feelers and ray-tree rays."""
+    r = st["rays"]
+    return r["total"]
+
+
+def cost_per_sample(st, plain):
+    """(us per camera ray, us per traced ray) of the tracing kernels: for adaptive
+    refinement its own batches against the rays beyond the plain render's, for uniform
+    supersampling the whole render."""
+    if st["aa"]["mode"] == "adaptive":
+        n = st["rays"]["refinement"]
+        ms = st["aa"]["refine_ms"]
+        rays = traced(st) - traced(plain)
+    else:
+        n = st["samples"]["total"]
+        ms = st["time_ms"]["kernels"]
+        rays = traced(st)
+    if n <= 0 or rays <= 0:
+        return "", ""
+    return f"{1000.0 * ms / n:.2f}", f"{1000.0 * ms / rays:.3f}"
 
 
 def main():
@@ -113,10 +144,14 @@ def main():
     ap.add_argument("--quick", action="store_true", help="tiny images, fewer settings (CI)")
     ap.add_argument("--vbcl", default="./vbcl")
     ap.add_argument("--out", default="bench-out")
+    ap.add_argument("--scenes", default="", help="only these scenes (file names without .json)")
     ap.add_argument("--repeats", type=int, default=None,
                     help="renders per setting, median time (default 3; --quick 1)")
     a = ap.parse_args()
     scenes = QUICK if a.quick else FULL
+    if a.scenes:
+        scenes = [sc for sc in scenes if os.path.splitext(os.path.basename(sc[0]))[0]
+                  in a.scenes.split(",")]
     thresholds = THRESHOLDS_QUICK if a.quick else THRESHOLDS_FULL
     uniform = UNIFORM_QUICK if a.quick else UNIFORM_FULL
     repeats = a.repeats or (1 if a.quick else 3)
@@ -124,35 +159,7 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for scene, label, size, extra in scenes:
-            name = os.path.splitext(os.path.basename(scene))[0]
-            ref_path = os.path.join(tmp, name + "_ref.exr")
-            # warm the program cache, then the reference
-            render(a.vbcl, scene, size, extra, [], os.path.join(tmp, "warm.exr"))
-            ref_scene = reseeded(scene)
-            try:
-                ref_ms, _ = render(a.vbcl, ref_scene, size, extra, ["--ssaa", "16"], ref_path)
-            finally:
-                os.remove(ref_scene)
-            ref = np.clip(read_exr(ref_path), 0.0, 1.0)
-            settings = [("adaptive", t, ["--aa", str(t)]) for t in thresholds]
-            settings += [("uniform", n, ["--ssaa", str(n)]) for n in uniform]
-            for method, param, opts in settings:
-                out = os.path.join(tmp, "img.exr")
-                times = []
-                for _ in range(repeats):
-                    ms, spp = render(a.vbcl, scene, size, extra, opts, out)
-                    times.append(ms)
-                img = np.clip(read_exr(out), 0.0, 1.0)
-                rmse = float(np.sqrt(np.mean((img - ref) ** 2)))
-                psnr = 20.0 * np.log10(1.0 / rmse) if rmse > 0 else float("inf")
-                row = {"scene": name, "size": f"{size}x{size}", "method": method,
-                       "param": param, "render_ms": round(float(np.median(times)), 1),
-                       "samples_per_pixel": spp, "rmse": f"{rmse:.6g}",
-                       "psnr_db": f"{psnr:.2f}", "reference_ms": round(ref_ms, 1),
-                       "label": label}
-                rows.append(row)
-                print(f"{name:22s} {method:8s} {param!s:5s} {row['render_ms']:9.1f} ms "
-                      f"{spp:7.2f} spp  RMSE {rmse:.5f}  PSNR {psnr:6.2f} dB", flush=True)
+            rows += bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats)
     csv_path = os.path.join(a.out, "aa_time_error.csv")
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k != "label"],
@@ -163,9 +170,55 @@ def main():
     print(f"bench_aa: wrote {csv_path} and {os.path.join(a.out, 'aa_time_error.png')}")
 
 
+def bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats):
+    """The rows of one scene: its reference, then every setting (median time of repeats)."""
+    name = os.path.splitext(os.path.basename(scene))[0]
+    ref_path = os.path.join(tmp, name + "_ref.exr")
+    # warm the program cache and PoCL's kernels (compiled at their first launch, once per
+    # work-group size, which is fixed), then the reference
+    for opts in (["--aa", "0.1"], ["--ssaa", "2"]):
+        render(a.vbcl, scene, 8, extra, opts, os.path.join(tmp, "warm.exr"))
+    plain = render(a.vbcl, scene, size, extra, ["--aa", "0"], os.path.join(tmp, "warm.exr"),
+                   full=True)
+    ref_scene = reseeded(scene)
+    try:
+        ref_ms, _ = render(a.vbcl, ref_scene, size, extra, ["--ssaa", "16"], ref_path)
+    finally:
+        os.remove(ref_scene)
+    ref = np.clip(read_exr(ref_path), 0.0, 1.0)
+    settings = [("adaptive", t, ["--aa", str(t)]) for t in thresholds]
+    # --ssaa 1 is the plain render; "--aa 0" also for scenes with their own render.aa
+    settings += [("uniform", n, ["--ssaa", str(n)] + (["--aa", "0"] if n == 1 else []))
+                 for n in uniform]
+    rows = []
+    for method, param, opts in settings:
+        out = os.path.join(tmp, "img.exr")
+        runs = [render(a.vbcl, scene, size, extra, opts, out, full=True) for _ in range(repeats)]
+        st = sorted(runs, key=lambda r: r["time_ms"]["render"])[len(runs) // 2]
+        spp = st["samples"]["per_pixel_mean"]
+        img = np.clip(read_exr(out), 0.0, 1.0)
+        rmse = float(np.sqrt(np.mean((img - ref) ** 2)))
+        psnr = 20.0 * np.log10(1.0 / rmse) if rmse > 0 else float("inf")
+        us_sample, us_ray = cost_per_sample(st, plain)
+        row = {"scene": name, "size": f"{size}x{size}", "method": method,
+               "param": param, "render_ms": round(float(st["time_ms"]["render"]), 1),
+               "samples_per_pixel": spp, "rmse": f"{rmse:.6g}",
+               "psnr_db": f"{psnr:.2f}", "us_per_sample": us_sample, "us_per_ray": us_ray,
+               "reference_ms": round(ref_ms, 1), "label": label}
+        rows.append(row)
+        print(f"{name:22s} {method:8s} {param!s:5s} {row['render_ms']:9.1f} ms "
+              f"{spp:7.2f} spp  RMSE {rmse:.5f}  PSNR {psnr:6.2f} dB  "
+              f"{us_sample or '-':>6s} us/sample", flush=True)
+    return rows
+
+
 def plot(rows, scenes, path):
-    fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), squeeze=False)
-    for ax, (scene, label, size, _) in zip(axes[0], scenes):
+    cols = min(len(scenes), 2)
+    nrows = (len(scenes) + cols - 1) // cols
+    fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.4 * nrows), squeeze=False)
+    for ax in axes.flat[len(scenes):]:
+        ax.set_visible(False)
+    for ax, (scene, label, size, _) in zip(axes.flat, scenes):
         name = os.path.splitext(os.path.basename(scene))[0]
         for method, style, fmt in (("adaptive", "o-", "{:g}"), ("uniform", "s--", "{}x{}")):
             rs = [r for r in rows if r["scene"] == name and r["method"] == method]
@@ -176,7 +229,8 @@ def plot(rows, scenes, path):
                 txt = fmt.format(r["param"], r["param"]) if method == "uniform" else fmt.format(r["param"])
                 ax.annotate(txt, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ref_ms = next(r["reference_ms"] for r in rows if r["scene"] == name)
-        ax.set_title(f"{label}, {size}x{size}\nreference 16x16: {ref_ms / 1000:.1f} s", fontsize=9)
+        ref_txt = f"\nreference 16x16: {ref_ms / 1000:.1f} s" if ref_ms else ""
+        ax.set_title(f"{label}, {size}x{size}{ref_txt}", fontsize=9)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("render time (s)")

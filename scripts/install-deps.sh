@@ -1,10 +1,23 @@
 #!/bin/sh
 # install-deps.sh — installs what vbcl needs from Debian's packages, only what is missing.
 # Idempotent: a second run installs nothing. Uses sudo when not root.
+# usage: scripts/install-deps.sh [--bench]
+#   --bench  also what only `make bench` needs: Embree 3 (libembree-dev), which the bench part
+#            "embree" traces the same rays with (docs/benchmarks.md); the renderer never links it.
 set -eu
 
 PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo oclgrind clang \
 libcjson-dev libopenimageio-dev openimageio-tools python3 python3-numpy python3-matplotlib"
+BENCH_PACKAGES="libembree-dev"
+
+case "${1:-}" in
+"") ;;
+--bench) PACKAGES="$PACKAGES $BENCH_PACKAGES" ;;
+*)
+    echo "usage: scripts/install-deps.sh [--bench]" >&2
+    exit 2
+    ;;
+esac
 
 missing=""
 for p in $PACKAGES; do

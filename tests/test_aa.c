@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "aa.h"
+#include "aa_tree.h"
+#include "fixture.h"
 #include "harness.h"
 #include "image_io.h"
 #include "testutil.h"
@@ -20,6 +22,7 @@ typedef struct AaRender {
     float *px;
     int *levels;         /* NULL without --aa */
     double samples_mean; /* from --stats */
+    unsigned samples_max;
 } AaRender;
 
 /* Renders the test scene with extra options (to EXR, with --aa-map when map is set).
@@ -36,7 +39,9 @@ static int aa_render(const char *name, const char *extra, int map, AaRender *out
     CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
     if (rc) return -1;
     const char *at = strstr(log, "samples ");
-    CHECK(at && sscanf(at, "samples %lf", &out->samples_mean) == 1, "no samples line: %s", log);
+    CHECK(at && sscanf(at, "samples %lf per pixel (mean), %u", &out->samples_mean,
+                       &out->samples_max) == 2,
+          "no samples line: %s", log);
     if (image_read(img, &out->w, &out->h, &out->px, err, sizeof err)) {
         CHECK(0, "%s", err);
         return -1;
@@ -94,9 +99,9 @@ static int same_pixel(const AaRender *a, const AaRender *b, int i)
 }
 
 /* RMSE against --ssaa 16 falls as the threshold falls (1.0, 0.4, 0.1, 0.02); threshold 1.0
- * refines nothing (the contrast is at most 1); at 0.1 the samples are at most a quarter of
- * uniform 16x16; pixels that reach level 4 equal the reference exactly (the same sample
- * positions and jitter keys). */
+ * refines nothing (the contrast is at most 1); at 0.1 the samples are at most a twentieth
+ * of uniform 16x16 (the quadtree refines only the subpixels along the edges); no pixel
+ * takes more than 256 samples (a fully split pixel: its 256 leaves, each traced once). */
 static void test_aa_error_falls_with_threshold(void)
 {
     if (!tu_device()) {
@@ -125,14 +130,10 @@ static void test_aa_error_falls_with_threshold(void)
         CHECK(e[k] < e[k - 1], "RMSE falls: threshold %g %.5f, threshold %g %.5f", thr[k], e[k],
               thr[k - 1], e[k - 1]);
     CHECK(e[3] < 0.25 * e[0], "threshold 0.02 removes most of the error: %.5f vs %.5f", e[3], e[0]);
-    CHECK(frac[2] <= 0.25, "threshold 0.1 takes %.4f of the samples of uniform 16x16", frac[2]);
-    int top = 0, top_same = 0;
-    for (int i = 0; i < ref.w * ref.h; i++)
-        if (r[3].levels[i] == VBCL_AA_MAX_LEVEL) {
-            top++;
-            top_same += same_pixel(&r[3], &ref, i);
-        }
-    CHECK(top > 0 && top_same == top, "%d of %d level-4 pixels equal --ssaa 16", top_same, top);
+    CHECK(frac[2] <= 0.05, "threshold 0.1 takes %.4f of the samples of uniform 16x16", frac[2]);
+    for (int k = 0; k < 4; k++)
+        CHECK(r[k].samples_max <= 256, "threshold %g: %u samples in one pixel", thr[k],
+              r[k].samples_max);
     aa_free(&ref);
     aa_free(&plain);
     for (int k = 0; k < 4; k++) aa_free(&r[k]);
@@ -183,11 +184,10 @@ static void test_aa_flat_regions_never_refined(void)
     aa_free(&a);
 }
 
-/* A pixel's value depends only on its own level: every pixel at the same level in two
- * renders that refine different sets of pixels (thresholds 0.4 and 0.1, and max level 2)
- * is bit-identical, and every unrefined pixel equals the render without anti-aliasing —
- * so refining a pixel never changes a pixel outside its own box window. */
-static void test_aa_refinement_is_local(void)
+/* Pixels that no refinement touches (level 0) are bit-identical to the render without
+ * anti-aliasing, in renders that refine different sets of subpixels (thresholds 0.4 and
+ * 0.1, max level 2), and flat colour next to a refined edge stays exact. */
+static void test_aa_untouched_pixels_unchanged(void)
 {
     if (!tu_device()) {
         th_skip("no OpenCL device");
@@ -201,32 +201,18 @@ static void test_aa_refinement_is_local(void)
         if (aa_render(names[k], extra[k], 1, &a[k])) return;
     int n = plain.w * plain.h;
     for (int k = 0; k < 3; k++) {
-        int zero = 0, zero_same = 0;
+        int zero = 0, zero_same = 0, refined = 0;
         for (int i = 0; i < n; i++)
             if (a[k].levels[i] == 0) {
                 zero++;
                 zero_same += same_pixel(&a[k], &plain, i);
+            } else {
+                refined++;
             }
+        fprintf(stderr, "    %s: %d pixels untouched, %d refined\n", extra[k], zero, refined);
+        CHECK(refined > 0 && zero > n / 2, "%s: %d untouched, %d refined", extra[k], zero, refined);
         CHECK(zero_same == zero, "%s: %d of %d unrefined pixels equal the plain render", extra[k],
               zero_same, zero);
-        for (int j = k + 1; j < 3; j++) {
-            int both = 0, both_same = 0, differ = 0;
-            for (int i = 0; i < n; i++) {
-                if (a[k].levels[i] != a[j].levels[i]) {
-                    differ++;
-                    continue;
-                }
-                both++;
-                both_same += same_pixel(&a[k], &a[j], i);
-            }
-            fprintf(stderr,
-                    "    %s / %s: %d pixels at different levels, %d of %d at equal levels "
-                    "identical\n",
-                    extra[k], extra[j], differ, both_same, both);
-            CHECK(differ > 0, "%s and %s refine different pixels", extra[k], extra[j]);
-            CHECK(both_same == both, "%s / %s: %d of %d pixels at equal levels identical", extra[k],
-                  extra[j], both_same, both);
-        }
     }
     aa_free(&plain);
     for (int k = 0; k < 3; k++) aa_free(&a[k]);
@@ -260,9 +246,14 @@ static void test_aa_options(void)
         CHECK(rmse(&key, &cli) == 0.0, "render.aa differs from --aa: %g", rmse(&key, &cli));
         free(key.px);
     }
-    const char *bad[] = {
-        "--aa 1.5",       "--aa-max-level 5",       "--ssaa 17", "--ssaa 0", "--aa 0.1 --ssaa 4",
-        "--aa-map m.png", "--aa 0.1 --aa-map m.bmp"};
+    const char *bad[] = {"--aa 1.5",
+                         "--aa-max-level 5",
+                         "--ssaa 17",
+                         "--ssaa 0",
+                         "--aa 0.1 --ssaa 4",
+                         "--aa-map m.png",
+                         "--aa 0.1 --aa-map m.bmp",
+                         "--aa 0.1 --aa-floor 3"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(cmd, sizeof cmd, "%s %s -q -o %s/never.png %s", tu_vbcl, AA_SCENE, tu_tmpdir(),
                  bad[i]);
@@ -275,10 +266,245 @@ static void test_aa_options(void)
     aa_free(&cli);
 }
 
+/* The nested sample positions (kernels/aa_tree.h), checked over every node: a node's
+ * sample cell lies inside it; of its four children exactly one holds the node's sample,
+ * the three new children (aa_new_child) are the other three, each with its sample inside
+ * it; the pixel centre's cell is never a new sample. Then random refinements of a pixel:
+ * the samples traced (the centre, then three per split) never repeat, and they are exactly
+ * the samples of the leaves. */
+static void test_aa_samples_nested_never_retraced(void)
+{
+    for (int lv = 0; lv <= VBCL_AA_MAX_LEVEL; lv++)
+        for (int y = 0; y < (1 << lv); y++)
+            for (int x = 0; x < (1 << lv); x++) {
+                int s = AA_TREE_SIDE >> lv, cell = aa_node_sample_cell(lv, x, y);
+                int fx = cell % AA_TREE_SIDE, fy = cell / AA_TREE_SIDE;
+                CHECK(fx >= x * s && fx < (x + 1) * s && fy >= y * s && fy < (y + 1) * s,
+                      "node (%d, %d, %d): sample cell %d outside it", lv, x, y, cell);
+                if (lv == VBCL_AA_MAX_LEVEL) continue;
+                unsigned code = aa_node_code(lv, x, y);
+                int holders = 0, seen = 0;
+                for (int c = 0; c < 4; c++)
+                    holders +=
+                        aa_node_sample_cell(lv + 1, 2 * x + (c & 1), 2 * y + (c >> 1)) == cell;
+                for (int j = 0; j < 3; j++) {
+                    unsigned ch = aa_new_child(code, j);
+                    int cx = aa_node_x(ch), cy = aa_node_y(ch);
+                    int cc = aa_node_sample_cell(lv + 1, cx, cy);
+                    CHECK(aa_node_level(ch) == lv + 1 && cx / 2 == x && cy / 2 == y,
+                          "node (%d, %d, %d): new child %d is no child", lv, x, y, j);
+                    CHECK(cc != cell && cc != AA_TREE_CENTRE_CELL,
+                          "node (%d, %d, %d): new child %d reuses cell %d", lv, x, y, j, cc);
+                    seen |= 1 << ((cy & 1) * 2 + (cx & 1));
+                }
+                CHECK(holders == 1 && seen != 15 && (seen | (seen >> 1)) != 0,
+                      "node (%d, %d, %d): %d children hold its sample, new ones %x", lv, x, y,
+                      holders, seen);
+            }
+    unsigned rng = 12345;
+    for (int trial = 0; trial < 200; trial++) {
+        unsigned leaves[256], traced[256];
+        int nleaves = 1, ntraced = 1;
+        leaves[0] = aa_node_code(0, 0, 0);
+        traced[0] = AA_TREE_CENTRE_CELL;
+        for (int step = 0; step < 40 + trial; step++) {
+            rng = rng * 1103515245u + 12345u;
+            int i = (int)((rng >> 8) % (unsigned)nleaves);
+            unsigned n = leaves[i];
+            if (aa_node_level(n) == VBCL_AA_MAX_LEVEL) continue;
+            int lv = aa_node_level(n), keep = aa_node_sample_cell(lv, aa_node_x(n), aa_node_y(n));
+            for (int j = 0; j < 3; j++) {
+                unsigned ch = aa_new_child(n, j);
+                traced[ntraced++] =
+                    (unsigned)aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch));
+                leaves[nleaves++] = ch;
+            }
+            for (int c = 0; c < 4; c++) { /* the child that keeps the sample replaces n */
+                unsigned ch =
+                    aa_node_code(lv + 1, 2 * aa_node_x(n) + (c & 1), 2 * aa_node_y(n) + (c >> 1));
+                if (aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch)) == keep)
+                    leaves[i] = ch;
+            }
+        }
+        int dup = 0, unmatched = 0;
+        for (int a = 0; a < ntraced; a++)
+            for (int b = a + 1; b < ntraced; b++) dup += traced[a] == traced[b];
+        for (int a = 0; a < nleaves; a++) {
+            unsigned n = leaves[a];
+            int cell = aa_node_sample_cell(aa_node_level(n), aa_node_x(n), aa_node_y(n)), found = 0;
+            for (int b = 0; b < ntraced; b++) found += traced[b] == (unsigned)cell;
+            unmatched += found != 1;
+        }
+        CHECK(ntraced == nleaves && dup == 0 && unmatched == 0,
+              "trial %d: %d samples traced for %d leaves, %d repeated, %d leaves unmatched", trial,
+              ntraced, nleaves, dup, unmatched);
+        if (th_checks_failed) break;
+    }
+}
+
+/* One two-pixel case of the contrast kernel: pixel 0 is a tree with every leaf at level
+ * l0 and value v0, pixel 1 at level l1 and value v1, except pixel 1's leaves listed in
+ * odd (codes) with value v_odd; want lists the marks expected as pixel << 16 | code. */
+typedef struct TwoPixelCase {
+    const char *what;
+    int l0, l1;
+    float v0, v1, v_odd;
+    unsigned odd[4], nodd;
+    unsigned want[12], nwant;
+    float floor; /* the contrast's floor on a + b (0: the thesis's plain ratio) */
+} TwoPixelCase;
+
+static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, unsigned nodd,
+                           float v_odd)
+{
+    for (int k = 0; k < VBCL_AA_CELLS; k++) {
+        int s = AA_TREE_SIDE >> lv, x = k % AA_TREE_SIDE / s, y = k / AA_TREE_SIDE / s;
+        float val = v;
+        for (unsigned i = 0; i < nodd; i++)
+            if (odd[i] == aa_node_code(lv, x, y)) val = v_odd;
+        for (int c = 0; c < 3; c++) cells[4 * k + c] = val;
+        cells[4 * k + 3] = (float)lv;
+    }
+}
+
+static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const int changed[2])
+{
+    static float tree[2 * VBCL_AA_CELLS * 4];
+    float film[8] = {0};
+    int slots[2] = {0, 1};
+    cl_uint counts[VBCL_AA_MAX_LEVEL + 2] = {0}, marks[2 * 64] = {0};
+    two_pixel_fill(tree, tc->l0, tc->v0, NULL, 0, 0.0f);
+    two_pixel_fill(tree + VBCL_AA_CELLS * 4, tc->l1, tc->v1, tc->odd, tc->nodd, tc->v_odd);
+    VbAaPass pass;
+    memset(&pass, 0, sizeof pass);
+    pass.threshold = 0.1f;
+    pass.floor = tc->floor;
+    pass.contrast_scale = 1.0f;
+    pass.max_level = VBCL_AA_MAX_LEVEL;
+    pass.width = 2;
+    pass.height = 1;
+    pass.round = round;
+    cl_mem m[7] = {buffer(&pass, sizeof pass),      buffer(film, sizeof film),
+                   buffer(slots, sizeof slots),     buffer(tree, sizeof tree),
+                   buffer(marks, sizeof marks),     buffer(counts, sizeof counts),
+                   buffer(changed, 2 * sizeof(int))};
+    const size_t sz[7] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                          sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem)};
+    const void *v[7] = {&m[0], &m[1], &m[2], &m[3], &m[4], &m[5], &m[6]};
+    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 7, sz, v) == 0) {
+        read_buffer(m[4], marks, sizeof marks);
+        read_buffer(m[5], counts, sizeof counts);
+        int missing = 0;
+        for (unsigned w = 0; w < tc->nwant; w++) {
+            int found = 0;
+            for (unsigned k = 0; k < counts[0] && k < 64; k++)
+                found += (marks[2 * k] << 16 | marks[2 * k + 1]) == tc->want[w];
+            missing += found != 1;
+        }
+        CHECK(counts[0] == tc->nwant && missing == 0,
+              "%s, round %d: %u marks, %u expected, %d missing", tc->what, round, counts[0],
+              tc->nwant, missing);
+    }
+    for (int i = 0; i < 7; i++) clReleaseMemObject(m[i]);
+}
+
+#define P0(l, x, y) (0u << 16 | ((l) << 8 | (y) << 4 | (x)))
+#define P1(l, x, y) (1u << 16 | ((l) << 8 | (y) << 4 | (x)))
+
+/* The quadtree's neighbour rule across levels and across the pixel border, on the
+ * contrast kernel itself with two refined pixels side by side: a leaf is compared with
+ * each adjacent leaf of its neighbour at the finer level of the two (8-neighbourhood, so
+ * corners count), and of a failing pair the leaf at the lower level splits, both on a tie.
+ * After round 0 only pixels whose neighbourhood was split in the last round are tested:
+ * the same cases in round 1 mark the same leaves when pixel 1 was split in round 0, and
+ * nothing when the last split was earlier. */
+static void test_aa_neighbour_rule_across_levels(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
+                          "\"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}}, "
+                          "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    const TwoPixelCase cases[] = {
+        /* pixel 1 finer and brighter everywhere: only pixel 0's two leaves along the
+         * border split; pixel 1's leaves see a coarser neighbour and wait */
+        {"finer neighbour", 1, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {P0(1, 1, 0), P0(1, 1, 1)}, 2, 0.0f},
+        /* one bright level-2 leaf of pixel 1 at the bottom of the border: pixel 0's
+         * lower-right leaf splits (pixel 1's other border leaves equal it), its
+         * upper-right one does not; inside pixel 1 the bright leaf and its three
+         * equal-level neighbours all split */
+        {"one subpixel",
+         1,
+         2,
+         0.5f,
+         0.5f,
+         1.0f,
+         {P1(2, 0, 3) & 0xffff},
+         1,
+         {P0(1, 1, 1), P1(2, 0, 3), P1(2, 0, 2), P1(2, 1, 2), P1(2, 1, 3)},
+         5,
+         0.0f},
+        /* a bright leaf higher up, (0, 1) (cells y 4..7): pixel 0's upper-right leaf
+         * (y 0..7) meets it along the border, the lower-right one (y 8..15) only through
+         * its corner cell (16, 7): both split */
+        {"corner",
+         1,
+         2,
+         0.5f,
+         0.5f,
+         1.0f,
+         {P1(2, 0, 1) & 0xffff},
+         1,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(2, 0, 1), P1(2, 0, 0), P1(2, 1, 0), P1(2, 1, 1), P1(2, 1, 2),
+          P1(2, 0, 2)},
+         8,
+         0.0f},
+        /* equal levels: both sides of the border split */
+        {"tie",
+         1,
+         1,
+         0.5f,
+         1.0f,
+         1.0f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
+         4,
+         0.0f},
+        /* a dark pair: relative contrast 0.33 splits both sides; with a floor of 0.5 on
+         * a + b the difference 0.01 is under 0.1 * 0.5 and nothing splits */
+        {"dark pair",
+         1,
+         1,
+         0.01f,
+         0.02f,
+         0.02f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
+         4,
+         0.0f},
+        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f},
+        /* below the threshold nothing splits */
+        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f},
+    };
+    const int fresh[2] = {-1, 0}, stale[2] = {-1, -1};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        two_pixel_run(&fx, &cases[i], 0, stale);
+        two_pixel_run(&fx, &cases[i], 1, fresh);
+        TwoPixelCase none = cases[i];
+        none.nwant = 0;
+        two_pixel_run(&fx, &none, 2, fresh);
+    }
+    fixture_close(&fx);
+}
+
 void suite_aa(void)
 {
     RUN_TEST(test_aa_error_falls_with_threshold);
     RUN_TEST(test_aa_flat_regions_never_refined);
-    RUN_TEST(test_aa_refinement_is_local);
+    RUN_TEST(test_aa_untouched_pixels_unchanged);
     RUN_TEST(test_aa_options);
+    RUN_TEST(test_aa_samples_nested_never_retraced);
+    RUN_TEST(test_aa_neighbour_rule_across_levels);
 }

@@ -47,7 +47,10 @@ typedef struct RenderStats {
     X(bands, "tree_trace_bands", VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)              \
     X(aa_generate, "aa_generate_rays", 0u)                                                         \
     X(aa_contrast, "aa_contrast_mark", 0u)                                                         \
-    X(aa_reconstruct, "aa_reconstruct", 0u)
+    X(aa_reconstruct, "aa_reconstruct", 0u)                                                        \
+    X(aa_split_rays, "aa_split_rays", 0u)                                                          \
+    X(aa_split_store, "aa_split_store", 0u)                                                        \
+    X(aa_resolve, "aa_resolve", 0u)
 
 /* A scene on a device, ready to trace: its buffers, the program and its kernels, and one
  * batch of rays (camera rays of a tile, or subpixel rays of anti-aliasing) at a time. */

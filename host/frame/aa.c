@@ -1,8 +1,9 @@
-/* aa.c — anti-aliasing on the device (thesis 4.1.2, figures 4.2–4.4): the contrast kernel
- * marks pixels over the whole image and compacts them into per-level lists; the marked
- * pixels are resampled one level deeper in bounded batches (aa_generate_rays, then the
- * frame's own tracing kernels, then aa_reconstruct), and this repeats until nothing is
- * marked. Uniform supersampling (--ssaa) runs the same batches over every pixel. */
+/* aa.c — anti-aliasing on the device (thesis 4.1.2, figures 4.2–4.4). Adaptive: each round
+ * the contrast kernel marks the quadtree leaves that fail against an adjacent leaf and
+ * compacts them into one list; the list is traced in full batches of three new samples
+ * per marked node (aa_split_rays, the frame's tracing kernels, aa_split_store), and this
+ * repeats until nothing is marked; aa_resolve then makes each refined pixel the mean of
+ * its leaves. Uniform supersampling (--ssaa) traces N x N samples of every pixel. */
 #include "aa.h"
 
 #include <math.h>
@@ -10,8 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Creates the anti-aliasing buffers (film, level map, mark list) once.
- * Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
+enum { AA_COUNTS = VBCL_AA_MAX_LEVEL + 2 }; /* marks, marks per level 0..3(4), tree slots */
+
+/* Creates the buffers every anti-aliasing mode needs (pass, film, slots, info, counts)
+ * once. Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
 static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t errlen)
 {
     if (aa->pass) return 0;
@@ -27,93 +30,62 @@ static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t 
     }
     aa->pass = clu_buffer(d, NULL, sizeof(VbAaPass), CL_MEM_READ_WRITE);
     aa->film = clu_buffer(d, NULL, sizeof(float) * 4 * npix, CL_MEM_READ_WRITE);
-    aa->levels = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
-    aa->marks = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
-    aa->mark_counts = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, CL_MEM_READ_WRITE);
-    if (aa->pass && aa->film && aa->levels && aa->marks && aa->mark_counts) return 0;
+    aa->slots = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    aa->info = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    aa->counts = clu_buffer(d, NULL, sizeof(cl_uint) * AA_COUNTS, CL_MEM_READ_WRITE);
+    aa->changed = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
+    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->changed) return 0;
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
 }
 
-/* Supersamples `count` pixels — list entries first.. of aa->marks, or pixels first.. with
- * pass->identity — with side x side samples each, in batches that fit the ray buffers;
- * each batch is generated, traced by the frame's kernels and reconstructed into the film.
- * Returns 0, or -1 with the error recorded. */
-static int aa_run_batches(AaState *aa, Renderer *r, VbAaPass *pass, unsigned first, unsigned count,
-                          int side, RenderStats *st)
+/* Makes *buf hold at least `need` elements of `elem` bytes (capacity *cap), keeping its
+ * first `keep` elements: a new buffer of twice the need, the old contents copied. Returns
+ * 0, 1 (device) or 2 (more than one allocation allows) with a message in err. */
+static int aa_reserve(Renderer *r, cl_mem *buf, size_t *cap, size_t need, size_t elem, size_t keep,
+                      const char *what, char *err, size_t errlen)
 {
     VbDevice *d = r->dev;
-    unsigned nsub = (unsigned)(side * side);
-    unsigned per = (unsigned)r->ray_capacity / nsub;
-    if (per < 1) per = 1;
-    pass->side = side;
-    for (unsigned done = 0; done < count; done += per) {
-        unsigned k = count - done < per ? count - done : per;
-        int nrays = (int)(k * nsub);
-        cl_event ev[2] = {0};
-        size_t g_rays = ((size_t)nrays + 63) / 64 * 64, g_pix = ((size_t)k + 63) / 64 * 64;
-        pass->first = first + done;
-        pass->entries = k;
-        CL_CHECK(
-            clEnqueueWriteBuffer(d->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL, NULL),
-            fail);
-        const cl_uint a = RENDER_FRAME_ARGS;
-        if (renderer_set_frame_args(r, r->k_aa_generate, r->rays, nrays, r->hits, r->media,
-                                    r->radiance, r->counters) ||
-            clu_set_arg(r->k_aa_generate, a, sizeof(cl_mem), &aa->pass) ||
-            clu_set_arg(r->k_aa_generate, a + 1, sizeof(cl_mem), &aa->marks))
-            goto fail;
-        CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_generate, 1, NULL, &g_rays,
-                                        renderer_local(r, g_rays), 0, NULL, &ev[0]),
-                 fail);
-        double trace_ms = 0.0;
-        if (renderer_trace_rays(r, nrays, st, &trace_ms)) goto fail;
-        const cl_mem args[5] = {aa->pass, aa->marks, r->radiance, aa->film, aa->levels};
-        for (cl_uint i = 0; i < 5; i++)
-            if (clu_set_arg(r->k_aa_reconstruct, i, sizeof(cl_mem), &args[i])) goto fail;
-        CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_reconstruct, 1, NULL, &g_pix,
-                                        renderer_local(r, g_pix), 0, NULL, &ev[1]),
-                 fail);
-        CL_CHECK(clFinish(d->queue), fail);
-        double gen_ms = clu_event_ms(ev[0]);
-        st->camera_ms += gen_ms;
-        st->aa_refine_ms += gen_ms + trace_ms;
-        st->aa_reconstruct_ms += clu_event_ms(ev[1]);
-        for (int i = 0; i < 2; i++) clReleaseEvent(ev[i]);
-        continue;
-    fail:
-        for (int i = 0; i < 2; i++)
-            if (ev[i]) clReleaseEvent(ev[i]);
-        return -1;
+    if (need <= *cap) return 0;
+    size_t want = 2 * need;
+    if (want * elem > d->max_alloc) want = d->max_alloc / elem;
+    if (want < need) {
+        snprintf(err, errlen,
+                 "anti-aliasing needs %.0f MiB for its %s, more than one allocation on %s "
+                 "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
+                 (double)(need * elem) / 1048576.0, what, d->name,
+                 (double)d->max_alloc / 1048576.0);
+        return 2;
     }
+    cl_mem nb = clu_buffer(d, NULL, want * elem, CL_MEM_READ_WRITE);
+    if (!nb) goto fail;
+    if (keep)
+        CL_CHECK(clEnqueueCopyBuffer(d->queue, *buf, nb, 0, 0, keep * elem, 0, NULL, NULL), fail);
+    CL_CHECK(clFinish(d->queue), fail);
+    if (*buf) CL_WARN(clReleaseMemObject(*buf));
+    *buf = nb;
+    *cap = want;
     return 0;
+fail:
+    if (nb) CL_WARN(clReleaseMemObject(nb));
+    snprintf(err, errlen, "%s: %s", d->name, clu_error());
+    return 1;
 }
 
-/* The contrast pass: marks the pixels to refine into per-level segments of aa->marks.
- * counts[l] receives how many pixels at level l were marked. Returns 0 or -1. */
-static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, cl_uint counts[],
-                   RenderStats *st)
+/* Enqueues kernel k over `global` work items with the given buffers as its arguments
+ * (from argument `first` on) and waits; adds its device time to *ms. Returns 0 or -1. */
+static int aa_launch(Renderer *r, cl_kernel k, cl_uint first, const cl_mem *args, int nargs,
+                     size_t items, double *ms)
 {
-    VbDevice *d = r->dev;
     cl_event ev = NULL;
-    cl_uint zero[VBCL_AA_MAX_LEVEL] = {0};
-    size_t npix = (size_t)s->width * (size_t)s->height, global = (npix + 63) / 64 * 64;
-    CL_CHECK(
-        clEnqueueWriteBuffer(d->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL, NULL),
-        fail);
-    CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->mark_counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL,
-                                  NULL),
+    size_t global = (items + 63) / 64 * 64;
+    for (int i = 0; i < nargs; i++)
+        if (clu_set_arg(k, first + (cl_uint)i, sizeof(cl_mem), &args[i])) return -1;
+    CL_CHECK(clEnqueueNDRangeKernel(r->dev->queue, k, 1, NULL, &global, renderer_local(r, global),
+                                    0, NULL, &ev),
              fail);
-    const cl_mem args[5] = {aa->pass, aa->film, aa->levels, aa->marks, aa->mark_counts};
-    for (cl_uint i = 0; i < 5; i++)
-        if (clu_set_arg(r->k_aa_contrast, i, sizeof(cl_mem), &args[i])) goto fail;
-    CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_aa_contrast, 1, NULL, &global,
-                                    renderer_local(r, global), 0, NULL, &ev),
-             fail);
-    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->mark_counts, CL_TRUE, 0,
-                                 sizeof(cl_uint) * VBCL_AA_MAX_LEVEL, counts, 0, NULL, NULL),
-             fail);
-    st->aa_contrast_ms += clu_event_ms(ev);
+    CL_CHECK(clWaitForEvents(1, &ev), fail);
+    *ms += clu_event_ms(ev);
     clReleaseEvent(ev);
     return 0;
 fail:
@@ -121,83 +93,256 @@ fail:
     return -1;
 }
 
-static void pass_init(VbAaPass *pass, const Scene *s)
+static int aa_write_pass(AaState *aa, Renderer *r, const VbAaPass *pass)
 {
-    memset(pass, 0, sizeof *pass);
-    pass->threshold = s->aa_threshold;
-    pass->contrast_scale = exp2f(s->exposure);
-    pass->max_level = s->aa_max_level;
-    pass->width = s->width;
-    pass->height = s->height;
+    CL_CHECK(clEnqueueWriteBuffer(r->dev->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL,
+                                  NULL),
+             fail);
+    return 0;
+fail:
+    return -1;
 }
 
-int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *err,
-              size_t errlen)
+/* Traces `nrays` rays that kernel gen (a frame kernel taking the pass, and the mark list
+ * when marks is set) generates for the batch in pass, into r->radiance. Returns 0 or -1. */
+static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, const VbAaPass *pass,
+                          int with_marks, int nrays, RenderStats *st)
 {
-    int rc = aa_setup(aa, r, s, err, errlen);
-    if (rc) return rc;
+    const cl_uint a = RENDER_FRAME_ARGS;
+    double gen_ms = 0.0, trace_ms = 0.0;
+    if (aa_write_pass(aa, r, pass) || renderer_set_frame_args(r, gen, r->rays, nrays, r->hits,
+                                                              r->media, r->radiance, r->counters))
+        return -1;
+    const cl_mem args[2] = {aa->pass, aa->marks};
+    if (aa_launch(r, gen, a, args, with_marks ? 2 : 1, (size_t)nrays, &gen_ms) ||
+        renderer_trace_rays(r, nrays, st, &trace_ms))
+        return -1;
+    st->camera_ms += gen_ms;
+    st->aa_refine_ms += gen_ms + trace_ms;
+    return 0;
+}
+
+/* The contrast pass: marks the leaves to split into aa->marks; counts[0] receives how many,
+ * counts[1 + l] how many at level l, counts[AA_COUNTS - 1] the tree slots in use. Returns
+ * 0 or -1. */
+static int aa_mark(AaState *aa, Renderer *r, const Scene *s, const VbAaPass *pass,
+                   cl_uint counts[AA_COUNTS], RenderStats *st)
+{
+    VbDevice *d = r->dev;
+    cl_uint zero[AA_COUNTS - 1] = {0};
+    if (aa_write_pass(aa, r, pass)) return -1;
+    CL_CHECK(
+        clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL, NULL),
+        fail);
+    const cl_mem args[7] = {aa->pass,  aa->film,   aa->slots,  aa->tree,
+                            aa->marks, aa->counts, aa->changed};
+    if (aa_launch(r, r->k_aa_contrast, 0, args, 7, (size_t)s->width * (size_t)s->height,
+                  &st->aa_contrast_ms))
+        return -1;
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
+                                 counts, 0, NULL, NULL),
+             fail);
+    return 0;
+fail:
+    return -1;
+}
+
+/* Progress of refinement on stderr (like pass 0's): the round, the deepest level it
+ * reaches, samples so far and the time left in the round at its rate so far. */
+typedef struct AaProgress {
+    int on, shown;
+    double t_start, t_round;
+} AaProgress;
+
+static void aa_progress(AaProgress *pg, int round, int level, unsigned long long samples,
+                        unsigned long long npix, double done, double total)
+{
+    double now = clu_now_ms(), el = now - pg->t_start, rel = now - pg->t_round;
+    if (!pg->on || (el < 1000.0 && !pg->shown)) return;
+    double eta = done > 0 ? rel * (total - done) / done : 0.0;
+    fprintf(stderr,
+            "\rvbcl: anti-aliasing round %d, level %d: %3.0f%%, %llu samples (%.1f/pixel), "
+            "%.1f s, round done in about %.1f s ",
+            round + 1, level, 100.0 * done / total, samples, (double)samples / (double)npix,
+            el / 1000.0, eta / 1000.0);
+    pg->shown = 1;
+}
+
+/* Splits the `marked` nodes listed in aa->marks: batches of whole nodes (three rays each)
+ * as wide as the ray buffers, each traced and stored into the trees. Returns 0 or -1. */
+static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, RenderStats *st,
+                    AaProgress *pg, int round, int level, unsigned long long npix)
+{
+    unsigned per = (unsigned)r->ray_capacity / 3;
+    for (unsigned done = 0; done < marked; done += per) {
+        unsigned k = marked - done < per ? marked - done : per;
+        pass->first = done;
+        pass->entries = k;
+        if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
+        const cl_mem args[7] = {aa->pass,  aa->marks,       r->radiance, aa->film,
+                                aa->slots, aa->slot_pixels, aa->tree};
+        const cl_mem more[2] = {aa->counts, aa->changed};
+        if (clu_set_arg(r->k_aa_split_store, 7, sizeof(cl_mem), &more[0]) ||
+            clu_set_arg(r->k_aa_split_store, 8, sizeof(cl_mem), &more[1]) ||
+            aa_launch(r, r->k_aa_split_store, 0, args, 7, k, &st->aa_reconstruct_ms))
+            return -1;
+        st->samples += 3ull * k;
+        aa_progress(pg, round, level, st->samples, npix, done + k, marked);
+    }
+    return 0;
+}
+
+/* Ends refinement: each refined pixel becomes the mean of its leaves (aa_resolve), the
+ * film and each pixel's deepest level and leaf count come back, and st gets the samples
+ * per pixel (max) and the pixels that reached each level. Returns 0 or -1. */
+static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned slots,
+                     float *rgba, RenderStats *st)
+{
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
-    cl_int zero = 0;
-    unsigned long long at_level[VBCL_AA_MAX_LEVEL + 1] = {npix}; /* pixels at each level */
-    VbAaPass pass;
-    pass_init(&pass, s);
-    pass.write_level = 1;
+    pass->entries = slots;
+    const cl_mem args[5] = {aa->pass, aa->slot_pixels, aa->tree, aa->film, aa->info};
+    if (slots && (aa_write_pass(aa, r, pass) ||
+                  aa_launch(r, r->k_aa_resolve, 0, args, 5, slots, &st->aa_reconstruct_ms)))
+        return -1;
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
+                                 NULL, NULL),
+             fail);
+    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->info, CL_TRUE, 0, sizeof(int) * npix,
+                                 aa->levels_host, 0, NULL, NULL),
+             fail);
+    st->samples_max = 1;
+    for (size_t i = 0; i < npix; i++) {
+        int info = aa->levels_host[i];
+        aa->levels_host[i] = info & 0xff;
+        aa->leaves_host[i] = info ? info >> 8 : 1;
+        if ((unsigned)aa->leaves_host[i] > st->samples_max)
+            st->samples_max = (unsigned)aa->leaves_host[i];
+        for (int l = 1; l <= aa->levels_host[i]; l++) st->aa_refined[l]++;
+    }
+    return 0;
+fail:
+    return -1;
+}
+
+/* Uploads the frame and pass 0's image, clears the slots, info and tree counter, and makes
+ * room for the first tree slots. Returns 0, 1 or 2 as aa_reserve. */
+static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba, char *err,
+                    size_t errlen)
+{
+    VbDevice *d = r->dev;
+    size_t npix = (size_t)s->width * (size_t)s->height;
+    cl_int none = -1, zero = 0;
+    cl_uint counts[AA_COUNTS] = {0};
     aa->levels_host = malloc(sizeof(int) * npix); /* frame_render freed the last frame's */
-    if (!aa->levels_host) {
+    aa->leaves_host = malloc(sizeof(int) * npix);
+    if (!aa->levels_host || !aa->leaves_host) {
         snprintf(err, errlen, "out of memory");
         return 1;
     }
+    int rc = aa_reserve(r, &aa->tree, &aa->tree_cap, 64, sizeof(float) * 4 * VBCL_AA_CELLS, 0,
+                        "trees", err, errlen);
+    if (!rc)
+        rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, 64, sizeof(cl_int), 0, "trees",
+                        err, errlen);
+    if (!rc)
+        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, npix, sizeof(cl_uint) * 2, 0, "mark list",
+                        err, errlen);
+    if (rc) return rc;
     CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof r->frame_host,
                                   &r->frame_host, 0, NULL, NULL),
              fail);
     CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                   NULL, NULL),
              fail);
-    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->levels, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->slots, &none, sizeof none, 0, sizeof(cl_int) * npix,
                                  0, NULL, NULL),
              fail);
-    for (int round = 0; round < AA_MAX_ROUNDS; round++) {
-        cl_uint counts[VBCL_AA_MAX_LEVEL] = {0};
-        unsigned long long offset = 0, marked = 0;
-        for (int l = 0; l < VBCL_AA_MAX_LEVEL; l++) {
-            pass.seg_offset[l] = (unsigned)offset;
-            offset += at_level[l];
-        }
-        if (aa_mark(aa, r, s, &pass, counts, st)) goto fail;
-        for (int l = 0; l < VBCL_AA_MAX_LEVEL; l++) marked += counts[l];
-        if (marked == 0) break;
-        st->aa_rounds++;
-        /* each marked pixel goes one level up: 2^(l+1) x 2^(l+1) new samples */
-        for (int l = VBCL_AA_MAX_LEVEL - 1; l >= 0; l--) {
-            if (!counts[l]) continue;
-            pass.level = l + 1;
-            if (aa_run_batches(aa, r, &pass, pass.seg_offset[l], counts[l], 1 << (l + 1), st))
-                goto fail;
-            st->aa_refined[l + 1] += counts[l];
-            at_level[l] -= counts[l];
-            at_level[l + 1] += counts[l];
-        }
-    }
-    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
-                                 NULL, NULL),
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->info, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
+                                 0, NULL, NULL),
              fail);
-    CL_CHECK(clEnqueueReadBuffer(d->queue, aa->levels, CL_TRUE, 0, sizeof(int) * npix,
-                                 aa->levels_host, 0, NULL, NULL),
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->changed, &none, sizeof none, 0,
+                                 sizeof(cl_int) * npix, 0, NULL, NULL),
              fail);
-    /* samples of a pixel at level L: its centre, then 4 + 16 + ... + 4^L */
-    st->samples = 0;
-    st->samples_max = 1;
-    for (size_t i = 0; i < npix; i++) {
-        unsigned n = 1;
-        for (int l = 1; l <= aa->levels_host[i]; l++) n += 1u << (2 * l);
-        st->samples += n;
-        if (n > st->samples_max) st->samples_max = n;
-    }
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
+                                  NULL),
+             fail);
     return 0;
 fail:
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
+}
+
+static void pass_init(VbAaPass *pass, const Scene *s)
+{
+    memset(pass, 0, sizeof *pass);
+    pass->threshold = s->aa_threshold;
+    pass->floor = s->aa_floor;
+    pass->contrast_scale = exp2f(s->exposure);
+    pass->max_level = s->aa_max_level;
+    pass->width = s->width;
+    pass->height = s->height;
+}
+
+/* The deepest level the marked leaves of a round split into. */
+static int aa_round_level(const cl_uint counts[AA_COUNTS])
+{
+    int deepest = 0;
+    for (int l = 0; l < VBCL_AA_MAX_LEVEL; l++)
+        if (counts[1 + l]) deepest = l + 1;
+    return deepest;
+}
+
+int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
+              char *err, size_t errlen)
+{
+    int rc = aa_setup(aa, r, s, err, errlen);
+    if (!rc) rc = aa_start(aa, r, s, rgba, err, errlen);
+    if (rc) return rc;
+    unsigned long long npix = (unsigned long long)s->width * (unsigned long long)s->height;
+    unsigned long long leaves = npix;
+    unsigned slots = 0;
+    AaProgress pg = {progress, 0, clu_now_ms(), 0.0};
+    VbAaPass pass;
+    pass_init(&pass, s);
+    st->samples = npix;
+    for (int round = 0; round < AA_MAX_ROUNDS; round++) {
+        cl_uint counts[AA_COUNTS];
+        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, leaves, sizeof(cl_uint) * 2, 0, "mark list",
+                        err, errlen);
+        if (rc) goto out;
+        rc = 1;
+        pass.round = round;
+        if (aa_mark(aa, r, s, &pass, counts, st)) goto fail;
+        if (counts[0] == 0) break;
+        st->aa_rounds++;
+        /* pixels split for the first time take a tree slot each */
+        size_t need = (size_t)slots + counts[1];
+        rc = aa_reserve(r, &aa->tree, &aa->tree_cap, need, sizeof(float) * 4 * VBCL_AA_CELLS, slots,
+                        "trees", err, errlen);
+        if (!rc)
+            rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, need, sizeof(cl_int), slots,
+                            "trees", err, errlen);
+        if (rc) goto out;
+        rc = 1;
+        pg.t_round = clu_now_ms();
+        if (aa_split(aa, r, &pass, counts[0], st, &pg, round, aa_round_level(counts), npix))
+            goto fail;
+        slots += counts[1];
+        leaves += 3ull * counts[0];
+    }
+    rc = 1;
+    if (aa_finish(aa, r, s, &pass, slots, rgba, st)) goto fail;
+    rc = 0;
+    goto out;
+fail:
+    snprintf(err, errlen, "%s: %s", r->dev->name, clu_error());
+out:
+    if (pg.shown)
+        fprintf(stderr, "\rvbcl: anti-aliasing %d rounds, %.1f samples per pixel (%.1f s)%40s\n",
+                st->aa_rounds, (double)st->samples / (double)npix,
+                (clu_now_ms() - pg.t_start) / 1000.0, "");
+    return rc;
 }
 
 int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st,
@@ -207,13 +352,22 @@ int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba,
     if (rc) return rc;
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
+    unsigned per = (unsigned)r->ray_capacity / (unsigned)(n * n);
     VbAaPass pass;
     pass_init(&pass, s);
-    pass.identity = 1;
+    pass.side = n;
     CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof r->frame_host,
                                   &r->frame_host, 0, NULL, NULL),
              fail);
-    if (aa_run_batches(aa, r, &pass, 0, (unsigned)npix, n, st)) goto fail;
+    for (size_t done = 0; done < npix; done += per) {
+        unsigned k = npix - done < per ? (unsigned)(npix - done) : per;
+        pass.first = (unsigned)done;
+        pass.entries = k;
+        const cl_mem args[3] = {aa->pass, r->radiance, aa->film};
+        if (aa_trace_batch(aa, r, r->k_aa_generate, &pass, 0, (int)(k * (unsigned)(n * n)), st) ||
+            aa_launch(r, r->k_aa_reconstruct, 0, args, 3, k, &st->aa_reconstruct_ms))
+            goto fail;
+    }
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
              fail);
@@ -227,10 +381,12 @@ fail:
 
 void aa_release(AaState *aa)
 {
-    cl_mem *mems[] = {&aa->pass, &aa->film, &aa->levels, &aa->marks, &aa->mark_counts};
+    cl_mem *mems[] = {&aa->pass, &aa->film,        &aa->slots, &aa->info,   &aa->counts,
+                      &aa->tree, &aa->slot_pixels, &aa->marks, &aa->changed};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);
+    free(aa->leaves_host);
     memset(aa, 0, sizeof *aa);
 }
 

@@ -1,29 +1,40 @@
-/* aa.h — anti-aliasing on the device (thesis 4.1.2): adaptive refinement of the pixels
- * that fail a contrast test against their neighbours, and uniform supersampling, both
- * through the same path (subpixel rays, the frame's tracing kernels, a box window). */
+/* aa.h — anti-aliasing on the device (thesis 4.1.2): adaptive refinement as a quadtree of
+ * subpixels whose leaves fail a contrast test against adjacent leaves, and uniform
+ * supersampling; both trace their samples through the frame's tracing kernels. */
 #ifndef VBCL_AA_H
 #define VBCL_AA_H
 
 #include "render.h"
 
-/* Safety bound on contrast rounds; each round raises some pixel's level, and renders
- * measured so far end in at most max_level + 3. */
-#define AA_MAX_ROUNDS 64
+/* Safety bound on contrast rounds (--stats reports the rounds run). Each round deepens some
+ * leaves; splits spread from leaf to adjacent leaf while the contrast lasts, so a long
+ * gradient can take many rounds. Measured: 5 – 20 rounds at 64² – 128², 28 for A.4 at 400². */
+#define AA_MAX_ROUNDS 256
 
 /* Anti-aliasing's own device state, created on first use: the film (the image being
- * refined), each pixel's level, the list of marked pixels and the pass constants. */
+ * refined), each pixel's tree slot, the pool of trees (256 cells of 16 bytes per refined
+ * pixel, grown as pixels are refined), the list of marked nodes and the counters. */
 typedef struct AaState {
-    cl_mem pass, film, levels, marks, mark_counts;
-    int *levels_host; /* after an adaptive render: each pixel's refinement level, else NULL */
+    cl_mem pass, film, slots, info, counts;
+    cl_mem changed;           /* each pixel's last round of splits, or -1 */
+    cl_mem tree, slot_pixels; /* tree_cap slots */
+    cl_mem marks;             /* mark_cap entries of (pixel, node code) */
+    size_t tree_cap, slot_pixels_cap, mark_cap;
+    int *levels_host; /* after an adaptive render: each pixel's deepest level, else NULL */
+    int *leaves_host; /* after an adaptive render: each pixel's number of leaves, else NULL */
 } AaState;
 
-/* Refines rgba (the pass-0 image, one ray per pixel centre) adaptively: contrast marks
- * with threshold s->aa_threshold, marked pixels resampled one level deeper by r's tracing
- * kernels, until nothing is marked or every marked pixel is at s->aa_max_level. Leaves
- * each pixel's level in aa->levels_host and the counts and times in st. Returns 0, or 1
- * (device) / 2 (the image does not fit the device's buffers) with a message in err. */
-int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, char *err,
-              size_t errlen);
+/* Refines rgba (the pass-0 image, one ray per pixel centre) adaptively: each round marks
+ * the leaves that fail the contrast test (threshold s->aa_threshold, floor s->aa_floor)
+ * against an adjacent leaf at their level or deeper, and splits them in four (three new
+ * samples each, traced by r's kernels), until nothing is marked; leaves at s->aa_max_level
+ * never split. rgba becomes the area-weighted mean of each pixel's leaves; pixels never
+ * split keep their pass-0 value bit for bit. Leaves each pixel's deepest level and leaf
+ * count in aa, and the counts and times in st; with progress set, reports on stderr once
+ * refinement has taken a second. Returns 0, or 1 (device) / 2 (the image or its trees do
+ * not fit the device's buffers) with a message in err. */
+int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
+              char *err, size_t errlen);
 
 /* Renders rgba with n x n samples at the subpixel centres of every pixel (n in 1..16),
  * box-filtered. Returns as aa_refine. */

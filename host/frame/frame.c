@@ -53,7 +53,8 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
     int rc;
     clu_error_clear();
     free(fr->aa.levels_host);
-    fr->aa.levels_host = NULL;
+    free(fr->aa.leaves_host);
+    fr->aa.levels_host = fr->aa.leaves_host = NULL;
     if (s->ssaa > 1) {
         rc = aa_supersample(&fr->aa, &fr->r, s, s->ssaa, rgba, st, err, errlen);
     } else {
@@ -62,7 +63,7 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
         st->samples_max = 1;
         unsigned long long centres = st->rays_primary;
         if (!rc && s->aa_threshold > 0.0f)
-            rc = aa_refine(&fr->aa, &fr->r, s, rgba, st, err, errlen);
+            rc = aa_refine(&fr->aa, &fr->r, s, rgba, st, progress, err, errlen);
         st->rays_refine = st->rays_primary - centres; /* a ray kind of its own in --stats */
         st->rays_primary = centres;
     }

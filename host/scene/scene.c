@@ -210,6 +210,15 @@ static int get_resolution(Ctx *c, const cJSON *j, const char *key, int max_axis,
     return 0;
 }
 
+/* render.aa, render.aa_max_level, render.aa_floor: adaptive anti-aliasing. */
+static int get_aa(Ctx *c, const cJSON *j, Scene *s)
+{
+    return json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
+           json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
+                        &s->aa_max_level) ||
+           json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor);
+}
+
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {"max_depth",
@@ -222,6 +231,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "min_weight",
                                        "aa",
                                        "aa_max_level",
+                                       "aa_floor",
                                        "bands",
                                        "shadow_jitter",
                                        "subgrid",
@@ -238,6 +248,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->min_weight = 1e-3f;
     s->aa_threshold = 0.0f;
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
+    s->aa_floor = SCENE_AA_FLOOR;
     s->ssaa = 1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
@@ -253,10 +264,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         json_get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
         json_get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
         json_get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight) ||
-        json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
-        json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
-                     &s->aa_max_level) ||
-        get_bands(c, j, s))
+        get_aa(c, j, s) || get_bands(c, j, s))
         return -1;
     s->seed = (unsigned)seed;
     const cJSON *jit = cJSON_GetObjectItemCaseSensitive(j, "shadow_jitter");

@@ -48,6 +48,9 @@ typedef struct SceneObject {
 /* How energy splits at an interface (render.fresnel). */
 enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
 
+/* render.aa_floor's default: the least a + b of the contrast test (display units). */
+#define SCENE_AA_FLOOR 0.0f
+
 typedef struct Scene {
     char *path; /* the scene file as given */
     char *dir;  /* its directory, for relative mesh paths */
@@ -73,6 +76,7 @@ typedef struct Scene {
     float min_weight;   /* ray-tree pruning threshold */
     float aa_threshold; /* adaptive anti-aliasing contrast threshold; 0: off */
     int aa_max_level;   /* deepest refinement level: 2^level x 2^level samples (1..4) */
+    float aa_floor;     /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
     int ssaa;           /* uniform N x N supersampling (command line only); 1: off */
     int bands;          /* render.bands: wavelength bands of a dispersive split */
     int band_layout;    /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
