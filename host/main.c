@@ -45,9 +45,13 @@ static const char usage_text[] =
     "                           default: all of them\n"
     "      --width N            image width in pixels (1..16384)\n"
     "      --height N           image height in pixels (1..16384)\n"
-    "      --grid auto|N|X,Y,Z  uniform grid resolution (default: auto; 1..1024 per axis,\n"
-    "                           at most 134217728 cells in all)\n"
+    "      --grid TOP[:SUB]     two-level grid: TOP, the top level, is auto, N or X,Y,Z\n"
+    "                           (1..1024 per axis, at most 134217728 cells in all; default\n"
+    "                           auto); SUB, the sub-grid in each crowded top cell, is auto\n"
+    "                           (default: sized by the cell's triangles) or N or X,Y,Z\n"
+    "                           (1..64) in every cell with 2 or more; :1 = one level only\n"
     "      --grid-density D     cells per triangle for --grid auto\n"
+    "      --subgrid-density D  sub-cells per triangle of a crowded top cell (default 2)\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
     "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
@@ -86,7 +90,7 @@ typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
-    double grid_density, exposure, min_weight, aa, aa_floor;
+    double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor;
     int have_exposure;
     int list_devices, stats, quiet;
 } Options;
@@ -147,6 +151,7 @@ static const OptionSpec option_specs[] = {
     {"--height", NULL, OPT_INT, offsetof(Options, height), 1, SCENE_MAX_IMAGE},
     {"--grid", NULL, OPT_STRING, offsetof(Options, grid), 0, 0},
     {"--grid-density", NULL, OPT_DOUBLE, offsetof(Options, grid_density), 0.01, 64},
+    {"--subgrid-density", NULL, OPT_DOUBLE, offsetof(Options, subgrid_density), 0.01, 64},
     {"--shadow-samples", NULL, OPT_INT, offsetof(Options, shadow_samples), 1, 1024},
     {"--depth", NULL, OPT_INT, offsetof(Options, depth), 1, 64},
     {"--min-weight", NULL, OPT_DOUBLE, offsetof(Options, min_weight), 0, 1},
@@ -245,7 +250,7 @@ static int parse_args(int argc, char **argv, Options *o)
 {
     memset(o, 0, sizeof *o);
     o->width = o->height = o->shadow_samples = o->depth = -1;
-    o->grid_density = o->min_weight = o->aa = o->aa_floor = -1;
+    o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
     o->aa_max_level = o->ssaa = o->bands = -1;
     o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
@@ -351,6 +356,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->height > 0) s->height = o->height;
     if (o->shadow_samples > 0) s->shadow_samples = o->shadow_samples;
     if (o->grid_density > 0) s->grid_density = (float)o->grid_density;
+    if (o->subgrid_density > 0) s->subgrid_density = (float)o->subgrid_density;
     if (o->have_exposure) s->exposure = (float)o->exposure;
     if (o->depth > 0) s->max_depth = o->depth;
     if (o->min_weight >= 0) s->min_weight = (float)o->min_weight;
@@ -370,9 +376,9 @@ static int apply_options(const Options *o, Scene *s)
         return usage_error("%s", "--aa-map needs adaptive anti-aliasing (--aa or render.aa)");
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
-    if (o->grid && scene_parse_grid(o->grid, s->grid_res))
-        return usage_error("--grid %s: expected auto, N or NX,NY,NZ (1..1024 each, at most 2^27 = "
-                           "134217728 cells in all)",
+    if (o->grid && scene_parse_grid_levels(o->grid, s->grid_res, s->subgrid_res))
+        return usage_error("--grid %s: expected TOP or TOP:SUB, each auto, N or NX,NY,NZ (TOP "
+                           "1..1024 each, at most 2^27 = 134217728 cells in all; SUB 1..64 each)",
                            diag_value(o->grid));
     return 0;
 }

@@ -46,6 +46,11 @@ static void print_setup(FILE *f, const StatsFrame *fr)
             g->n[0], g->n[1], g->n[2], g->ncells, s->grid_res[0] ? "given" : "auto", st->grid_ms,
             g->tris_per_cell_mean, g->tris_per_cell_max, 100.0 * g->empty_fraction,
             g->tris_per_nonempty_mean, g->refinements);
+    fprintf(f,
+            "sub-grids   %u of the top cells (%s), %u leaves (sub-cells and lists), %u triangle "
+            "references, at most %u in one leaf, build %.1f ms\n",
+            g->subgrids, s->subgrid_res[0] ? "given" : "auto", g->nleaves, g->nleaf_refs,
+            g->tris_per_leaf_max, g->leaves_ms);
 }
 
 /* ray trees, energy, dispersion, rays by depth (scenes with dielectrics) */
@@ -229,6 +234,11 @@ static void json_grid(cJSON *root, const StatsFrame *fr, int *ok)
     fnum(o, "empty_fraction", g->empty_fraction, ok);
     fnum(o, "tris_per_nonempty_cell_mean", g->tris_per_nonempty_mean, ok);
     num(o, "refinements", g->refinements, ok);
+    num(o, "subgrids", g->subgrids, ok);
+    num(o, "leaves", g->nleaves, ok);
+    num(o, "leaf_refs", g->nleaf_refs, ok);
+    num(o, "tris_per_leaf_max", g->tris_per_leaf_max, ok);
+    num(o, "leaves_build_ms", g->leaves_ms, ok);
 }
 
 /* rays, ray_tree, work: the kernels' counters go to the group VBCL_COUNTER_LIST names */

@@ -1,6 +1,9 @@
 #line 2 "grid.cl"
-/* grid.cl — uniform-grid traversal (Amanatides & Woo 1987): closest hit, accepted only
- * inside the current cell, and any hit for shadow feelers. */
+/* grid.cl — two-level grid traversal (Amanatides & Woo 1987 at both levels; Kalojanov,
+ * Stich & Slusallek 2011): the ray walks the top cells, and through a top cell with a
+ * sub-grid it walks that cell's sub-cells. Closest hit, accepted only inside the current
+ * (sub-)cell, and any hit for shadow feelers; grid_cell_box_range for walks of whole
+ * bundles of rays. */
 #ifndef VBCL_GRID_CL
 #define VBCL_GRID_CL
 
@@ -8,19 +11,30 @@
 
 /* Work counters of one ray, summed by the caller into the frame counters. */
 typedef struct TraceCount {
-    uint steps;
+    uint steps; /* top cells and sub-cells visited */
     uint tests;
 } TraceCount;
 
-/* State of a ray walking the grid, cell by cell. */
+/* State of a ray walking a grid (the top level, or one top cell's sub-grid), cell by cell. */
 typedef struct GridWalk {
     int3 cell;
     int3 step;
     float3 t_next;  /* ray parameter at the next cell boundary, per axis */
     float3 t_delta; /* ray parameter across one cell, per axis */
+    float3 inv;     /* 1 / direction */
     float t_enter;  /* where the ray enters the grid */
     float t_leave;  /* where it leaves it (or tmax) */
+    int axis;       /* the axis of the last step (the face the ray entered the cell by); -1 */
 } GridWalk;
+
+/* The state of a closest-hit search: the best hit so far and how far a candidate may lie
+ * (hit_before, hit_reach). */
+typedef struct Closest {
+    VbHit hit;
+    uint opaque;
+    float window;
+    float reach;
+} Closest;
 
 /* Clips the ray to the grid box and finds its first cell. Returns 0 when the ray misses
  * the grid or the part of it within (0, tmax]. */
@@ -48,31 +62,43 @@ VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir
     float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), w->step > 0)) * cs;
     w->t_next = select((boundary - org) * inv, (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
     w->t_delta = select(cs * fabs(inv), (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
+    w->inv = inv;
     w->t_enter = enter;
     w->t_leave = leave;
+    w->axis = -1;
     return 1;
 }
 
-/* Steps to the next cell; returns 0 when the ray leaves the grid or passes t_leave. */
-VB_INLINE int grid_walk_next(__constant const VbGrid *g, GridWalk *w)
+/* Steps to the next cell of a walk over n cells; returns 0 when the ray leaves them or
+ * passes t_leave. */
+VB_INLINE int grid_walk_step(int3 n, GridWalk *w)
 {
     float3 tn = w->t_next;
     if (tn.x < tn.y && tn.x < tn.z) {
         if (tn.x > w->t_leave) return 0;
         w->cell.x += w->step.x;
         w->t_next.x += w->t_delta.x;
-        return w->cell.x >= 0 && w->cell.x < g->n[0];
+        w->axis = 0;
+        return w->cell.x >= 0 && w->cell.x < n.x;
     }
     if (tn.y < tn.z) {
         if (tn.y > w->t_leave) return 0;
         w->cell.y += w->step.y;
         w->t_next.y += w->t_delta.y;
-        return w->cell.y >= 0 && w->cell.y < g->n[1];
+        w->axis = 1;
+        return w->cell.y >= 0 && w->cell.y < n.y;
     }
     if (tn.z > w->t_leave) return 0;
     w->cell.z += w->step.z;
     w->t_next.z += w->t_delta.z;
-    return w->cell.z >= 0 && w->cell.z < g->n[2];
+    w->axis = 2;
+    return w->cell.z >= 0 && w->cell.z < n.z;
+}
+
+/* Steps to the next top cell; returns 0 when the ray leaves the grid or passes t_leave. */
+VB_INLINE int grid_walk_next(__constant const VbGrid *g, GridWalk *w)
+{
+    return grid_walk_step((int3)(g->n[0], g->n[1], g->n[2]), w);
 }
 
 VB_INLINE int grid_cell_index(__constant const VbGrid *g, int3 c)
@@ -80,79 +106,238 @@ VB_INLINE int grid_cell_index(__constant const VbGrid *g, int3 c)
     return c.x + g->n[0] * (c.y + g->n[1] * c.z);
 }
 
-/* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell is
- * accepted only if it (and the window in which an opaque surface in contact would still
- * come first, hit_before) lies before the cell's exit, so a triangle that also spans later
- * cells cannot hide a closer one there. Ties go to the lower triangle index. */
-VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
-                                   __global const uint *cell_start, __global const uint *cell_tris,
-                                   float3 org, float3 dir, float tmax, TraceCount *count)
+/* A top cell's sub-grid resolution (1, 1, 1: a plain list). */
+VB_INLINE int3 grid_cell_res(VbGridCell gc)
 {
-    VbHit hit;
-    hit.t = tmax;
-    hit.tri = -1;
-    hit.u = hit.v = 0.0f;
-    GridWalk w;
-    if (!grid_walk_begin(g, org, dir, tmax, &w)) return hit;
-    RayShear rs = ray_shear_make(org, dir);
-    uint steps = 0, tests = 0, hit_opaque = 0u;
-    float window = 0.0f, reach = tmax;
-    do {
-        steps++;
-        int ci = grid_cell_index(g, w.cell);
-        uint begin = cell_start[ci], end = cell_start[ci + 1];
-        tests += end - begin;
-        for (uint k = begin; k < end; k++) {
-            int tri = (int)cell_tris[k];
-            float t, u, v;
-            if (tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                              tri_vertex(tris, tri, 2), reach, &t, &u, &v)) {
-                uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
-                if (hit_before(t, tri, opaque, hit, hit_opaque, window)) {
-                    hit.t = t;
-                    hit.tri = tri;
-                    hit.u = u;
-                    hit.v = v;
-                    hit_opaque = opaque;
-                    window = hit_contact_window(org, t);
-                    reach = hit_reach(hit, hit_opaque, window, tmax);
-                }
+    return (int3)((int)(gc.res & VBCL_GRID_SUB_MASK),
+                  (int)(gc.res >> VBCL_GRID_SUB_BITS & VBCL_GRID_SUB_MASK),
+                  (int)(gc.res >> (2 * VBCL_GRID_SUB_BITS) & VBCL_GRID_SUB_MASK));
+}
+
+/* The box of top cell c: its low corner, and the size of one of its n sub-cells. */
+VB_INLINE float3 grid_cell_lo(__constant const VbGrid *g, int3 c)
+{
+    return vb_cload3(g->lo) + convert_float3(c) * vb_cload3(g->cell);
+}
+
+/* Starts the walk of a ray through the sub-grid of n cells of the top cell the walk top is
+ * in, from t_in (where the ray enters that cell) to t_out (where it leaves it, or the walk
+ * ends). The first sub-cell is the one holding the point at t_in, on the face the ray
+ * entered by (exactly, whatever the rounding of that point). */
+VB_INLINE void grid_sub_begin(__constant const VbGrid *g, const GridWalk *top, int3 n, float3 org,
+                              float3 dir, float t_in, float t_out, GridWalk *s)
+{
+    float3 lo = grid_cell_lo(g, top->cell);
+    float3 scs = vb_cload3(g->cell) / convert_float3(n);
+    int3 c = clamp(convert_int3_sat_rtn((org + t_in * dir - lo) / scs), (int3)(0), n - 1);
+    int3 entry = select(n - 1, (int3)(0), top->step > 0);
+    int3 face = (int3)(top->axis == 0 ? -1 : 0, top->axis == 1 ? -1 : 0, top->axis == 2 ? -1 : 0);
+    c = select(c, entry, face);
+    s->cell = c;
+    s->step = top->step;
+    float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), top->step > 0)) * scs;
+    s->t_next =
+        select((boundary - org) * top->inv, (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
+    s->t_delta = top->t_delta / convert_float3(n);
+    s->inv = top->inv;
+    s->t_enter = t_in;
+    s->t_leave = t_out;
+    s->axis = -1;
+}
+
+/* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
+ * updating *c. Returns the number of tests. */
+VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
+                                 __global const VbTriangle *tris, __global const uint *leaf_start,
+                                 __global const uint *leaf_tris, uint leaf, Closest *c)
+{
+    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
+    for (uint k = begin; k < end; k++) {
+        int tri = (int)leaf_tris[k];
+        float t, u, v;
+        if (tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                          tri_vertex(tris, tri, 2), c->reach, &t, &u, &v)) {
+            uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
+            if (hit_before(t, tri, opaque, c->hit, c->opaque, c->window)) {
+                c->hit.t = t;
+                c->hit.tri = tri;
+                c->hit.u = u;
+                c->hit.v = v;
+                c->opaque = opaque;
+                c->window = hit_contact_window(org, t);
+                c->reach = hit_reach(c->hit, c->opaque, c->window, tmax);
             }
         }
+    }
+    return end - begin;
+}
+
+/* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell (a sub-cell
+ * where the top cell has a sub-grid) is accepted only if it (and the window in which an
+ * opaque surface in contact would still come first, hit_before) lies before that cell's
+ * exit, so a triangle that also spans later cells cannot hide a closer one there. Ties go
+ * to the lower triangle index. */
+VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
+                                   __global const VbGridCell *cells,
+                                   __global const uint *leaf_start, __global const uint *leaf_tris,
+                                   float3 org, float3 dir, float tmax, TraceCount *count)
+{
+    Closest c;
+    c.hit.t = tmax;
+    c.hit.tri = -1;
+    c.hit.u = c.hit.v = 0.0f;
+    c.opaque = 0u;
+    c.window = 0.0f;
+    c.reach = tmax;
+    GridWalk w;
+    if (!grid_walk_begin(g, org, dir, tmax, &w)) return c.hit;
+    RayShear rs = ray_shear_make(org, dir);
+    uint steps = 0, tests = 0;
+    float t_in = w.t_enter;
+    do {
+        steps++;
+        VbGridCell gc = cells[grid_cell_index(g, w.cell)];
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
-        if (hit.tri >= 0 && reach <= cell_exit) break;
+        if (gc.res == VBCL_GRID_LIST) {
+            tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_tris, gc.first, &c);
+        } else {
+            int3 n = grid_cell_res(gc);
+            GridWalk s;
+            grid_sub_begin(g, &w, n, org, dir, t_in, fmin(cell_exit, w.t_leave), &s);
+            do {
+                steps++;
+                uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
+                tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_tris, leaf, &c);
+                float sub_exit = fmin(s.t_next.x, fmin(s.t_next.y, s.t_next.z));
+                if (c.hit.tri >= 0 && c.reach <= fmin(sub_exit, cell_exit)) break;
+            } while (grid_walk_step(n, &s));
+        }
+        if (c.hit.tri >= 0 && c.reach <= cell_exit) break;
+        t_in = cell_exit;
     } while (grid_walk_next(g, &w));
     count->steps += steps;
     count->tests += tests;
-    return hit;
+    return c.hit;
+}
+
+/* Whether any triangle of one leaf lies on the ray before tmax; adds the tests to *tests. */
+VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
+                            __global const uint *leaf_start, __global const uint *leaf_tris,
+                            uint leaf, uint *tests)
+{
+    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
+    int blocked = 0;
+    for (uint k = begin; k < end && !blocked; k++) {
+        int tri = (int)leaf_tris[k];
+        float t, u, v;
+        (*tests)++;
+        blocked = tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                                tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
+    }
+    return blocked;
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow
  * feeler: the first occluder ends the walk). */
 VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
-                             __global const uint *cell_start, __global const uint *cell_tris,
-                             float3 org, float3 dir, float tmax, TraceCount *count)
+                             __global const VbGridCell *cells, __global const uint *leaf_start,
+                             __global const uint *leaf_tris, float3 org, float3 dir, float tmax,
+                             TraceCount *count)
 {
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return 0;
     RayShear rs = ray_shear_make(org, dir);
     uint steps = 0, tests = 0;
     int blocked = 0;
+    float t_in = w.t_enter;
     do {
         steps++;
-        int ci = grid_cell_index(g, w.cell);
-        uint begin = cell_start[ci], end = cell_start[ci + 1];
-        for (uint k = begin; k < end && !blocked; k++) {
-            int tri = (int)cell_tris[k];
-            float t, u, v;
-            tests++;
-            blocked = tri_intersect(&rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                                    tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
+        VbGridCell gc = cells[grid_cell_index(g, w.cell)];
+        float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
+        if (gc.res == VBCL_GRID_LIST) {
+            blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, gc.first, &tests);
+        } else {
+            int3 n = grid_cell_res(gc);
+            GridWalk s;
+            grid_sub_begin(g, &w, n, org, dir, t_in, fmin(cell_exit, w.t_leave), &s);
+            do {
+                steps++;
+                uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
+                blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, leaf, &tests);
+            } while (!blocked && grid_walk_step(n, &s));
         }
+        t_in = cell_exit;
     } while (!blocked && grid_walk_next(g, &w));
     count->steps += steps;
     count->tests += tests;
     return blocked;
 }
+
+/* The leaves of one top cell that an axis-aligned box overlaps: for a walk of whole bundles
+ * of rays, whose cone within the cell lies in the box. Leaf k of k = 0 .. count - 1 is
+ * grid_box_leaf(&range, k); its triangles are leaf_tris[leaf_start[leaf] ..
+ * leaf_start[leaf + 1] - 1]. A cell without a sub-grid gives its one list. A triangle can
+ * be listed in several of the leaves. */
+typedef struct GridBoxRange {
+    uint first; /* the cell's first leaf */
+    int3 n;     /* its sub-grid resolution */
+    int3 lo;    /* the first sub-cell of the box, per axis */
+    int3 size;  /* sub-cells of the box per axis */
+    uint count; /* size.x * size.y * size.z */
+} GridBoxRange;
+
+/* The sub-cells of top cell `cell` overlapping the box [blo, bhi] (world coordinates; the
+ * part beyond the cell is ignored, a box outside the cell gives its border sub-cells). The
+ * box is widened by 1e-3 of a sub-cell so that rounding never drops a sub-cell it touches
+ * (the build lists a triangle on a sub-cell face on both sides). */
+VB_INLINE GridBoxRange grid_cell_box_range(__constant const VbGrid *g,
+                                           __global const VbGridCell *cells, int3 cell, float3 blo,
+                                           float3 bhi)
+{
+    GridBoxRange r;
+    VbGridCell gc = cells[grid_cell_index(g, cell)];
+    r.first = gc.first;
+    r.n = grid_cell_res(gc);
+    float3 lo = grid_cell_lo(g, cell);
+    float3 iscs = convert_float3(r.n) / vb_cload3(g->cell);
+    int3 a = convert_int3_sat_rtn((blo - lo) * iscs - 1e-3f);
+    int3 b = convert_int3_sat_rtn((bhi - lo) * iscs + 1e-3f);
+    r.lo = clamp(a, (int3)(0), r.n - 1);
+    r.size = clamp(b, (int3)(0), r.n - 1) - r.lo + 1;
+    r.size = max(r.size, (int3)(1)); /* an inverted box: one border sub-cell */
+    r.count = (uint)(r.size.x * r.size.y * r.size.z);
+    return r;
+}
+
+/* Leaf k (0 .. r->count - 1) of a box range, x fastest. */
+VB_INLINE uint grid_box_leaf(const GridBoxRange *r, uint k)
+{
+    int x = r->lo.x + (int)(k % (uint)r->size.x);
+    int y = r->lo.y + (int)(k / (uint)r->size.x % (uint)r->size.y);
+    int z = r->lo.z + (int)(k / ((uint)r->size.x * (uint)r->size.y));
+    return r->first + (uint)(x + r->n.x * (y + r->n.y * z));
+}
+
+#ifdef VBCL_TEST_KERNELS
+/* For the tests: per query (a top cell and a box: cell xyz in q[0..2] as floats, box
+ * corners in q[4..6] and q[8..10], 12 floats a query) marks in mark[query * ntris + tri]
+ * every triangle of the leaves grid_cell_box_range gives. */
+__kernel void probe_grid_box_range(__constant const VbFrame *f, __global const VbGridCell *cells,
+                                   __global const uint *leaf_start, __global const uint *leaf_tris,
+                                   __global const float *q, uint nq, uint ntris,
+                                   __global uchar *mark)
+{
+    uint i = get_global_id(0);
+    if (i >= nq) return;
+    __global const float *p = q + 12 * i;
+    int3 cell = convert_int3((float3)(p[0], p[1], p[2]));
+    GridBoxRange r = grid_cell_box_range(&f->grid, cells, cell, vload3(0, p + 4), vload3(0, p + 8));
+    for (uint k = 0; k < r.count; k++) {
+        uint leaf = grid_box_leaf(&r, k);
+        for (uint j = leaf_start[leaf]; j < leaf_start[leaf + 1]; j++)
+            mark[(size_t)i * ntris + leaf_tris[j]] = 1;
+    }
+}
+#endif
 
 #endif

@@ -49,16 +49,16 @@ VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMater
 VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, float tmax,
                                     TraceCount *tc)
 {
-    return grid_trace_closest(&sc->f->grid, sc->tris, sc->cell_start, sc->cell_tris, org, dir, tmax,
-                              tc);
+    return grid_trace_closest(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_tris,
+                              org, dir, tmax, tc);
 }
 
 /* Whether anything lies on (org, dir) before tmax. */
 VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float tmax,
                               TraceCount *tc)
 {
-    return grid_trace_any(&sc->f->grid, sc->tris, sc->cell_start, sc->cell_tris, org, dir, tmax,
-                          tc);
+    return grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_tris,
+                          org, dir, tmax, tc);
 }
 
 /* Material of an opaque-scene triangle: its object's own material. */

@@ -161,7 +161,7 @@ typedef struct VbCamera {
     float up[4];      /* scaled by tan(fov/2) */
 } VbCamera;
 
-/* The uniform grid: bounds, resolution, cell size. */
+/* The top level of the two-level grid: bounds, resolution, cell size. */
 typedef struct VbGrid {
     float lo[4];
     float hi[4];
@@ -169,6 +169,18 @@ typedef struct VbGrid {
     float inv_cell[4]; /* 1 / cell size */
     int n[4];          /* cells per axis (w unused) */
 } VbGrid;
+
+/* A top cell of the grid: a sub-grid of res = x | y << 10 | z << 20 sub-cells (each axis
+ * 1 .. 1023), whose lists are leaves first .. first + x*y*z - 1 of the leaf offsets,
+ * sub-cell (i, j, k) at first + i + x*(j + y*k); VBCL_GRID_LIST (1x1x1) is a plain list,
+ * the one leaf `first`. Written by grid_build_leaves (host/accel/grid.c). */
+typedef struct VbGridCell {
+    unsigned int first;
+    unsigned int res;
+} VbGridCell;
+#define VBCL_GRID_SUB_BITS 10
+#define VBCL_GRID_SUB_MASK 1023u
+#define VBCL_GRID_LIST     (1u | 1u << VBCL_GRID_SUB_BITS | 1u << (2 * VBCL_GRID_SUB_BITS))
 
 /* Anti-aliasing (thesis 4.1.2): each pixel is the root of a quadtree of subpixels down to
  * level VBCL_AA_MAX_LEVEL (16x16); a leaf holds one sample, and the pixel is the
@@ -255,6 +267,7 @@ typedef struct VbSplitSet {
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
+    X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
     X(VBCL_OFFSETOF(VbFrame, grid)) X(VBCL_OFFSETOF(VbFrame, background))                          \
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
@@ -285,6 +298,8 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLight, radiance) == 16, light_radiance);
 VBCL_STATIC_ASSERT(sizeof(VbCamera) == 64, camera_size);
 VBCL_STATIC_ASSERT(sizeof(VbGrid) == 80, grid_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGrid, n) == 64, grid_n);
+VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
 VBCL_STATIC_ASSERT(sizeof(VbObject) == 16, object_size);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
 VBCL_STATIC_ASSERT(sizeof(VbFrame) == 240, frame_size);
@@ -328,8 +343,9 @@ VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, c
     X(__constant, VbFrame, f, frame)                                                               \
     X(__global, VbTriangle, tris, tris)                                                            \
     X(__global, VbTriNormals, normals, normals)                                                    \
-    X(__global, uint, cell_start, cell_start)                                                      \
-    X(__global, uint, cell_tris, cell_tris)                                                        \
+    X(__global, VbGridCell, grid_cells, grid_cells) /* one per top cell */                         \
+    X(__global, uint, leaf_start, leaf_start)       /* offsets of the leaves' lists */             \
+    X(__global, uint, leaf_tris, leaf_tris)         /* the lists: triangle indices */              \
     X(__global, VbMaterial, materials, materials)                                                  \
     X(__global, VbObject, objects, objects)                                                        \
     X(__global, VbLight, lights, lights)                                                           \

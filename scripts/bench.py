@@ -4,8 +4,9 @@
   1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
               threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
               dispersion time and the total, beside the thesis's 1995 figures;
-  2. grid     throughput (Mrays/s by ray kind) across grid sizes 5^3 .. 128^3 and auto on
-              scenes from about 100 to 184,000 triangles;
+  2. grid     throughput (Mrays/s by ray kind) across top-level grid sizes 5^3 .. 128^3,
+              the thesis's 20^3 and auto, with sub-grids (two levels) and without (one),
+              on scenes from about 100 to 184,000 triangles;
   3. error    run time against error (RMSE and PSNR against a converged reference) for
               anti-aliasing thresholds (scripts/bench_aa.py) and for band counts;
   4. build    kernel build time, cold (empty binary cache) and warm, per feature set;
@@ -69,9 +70,11 @@ GRID_SCENES = [
      ["--shadow-samples", "4"]),
     ("spheres36 (184,322 tris)", "scenes/bench/spheres36.json", []),
 ]
-GRID_SIZES = ["5", "8", "16", "32", "64", "128", "auto"]
+GRID_SIZES = ["5", "8", "16", "20", "32", "64", "128", "auto"]
 GRID_SCENES_QUICK = GRID_SCENES[:2]
 GRID_SIZES_QUICK = ["5", "16", "auto"]
+# The grid's levels: "two" is --grid N (automatic sub-grids), "one" is --grid N:1.
+GRID_LEVELS = [("two", ""), ("one", ":1")]
 
 BANDS = [1, 2, 4, 6, 8, 16, 32]
 BANDS_QUICK = [1, 4]
@@ -192,6 +195,23 @@ def part_thesis(a, out):
                        note)
 
 
+def grid_row(label, g, levels, st):
+    """One row of the grid part from the median stats of one (scene, grid, levels)."""
+    kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+    secondary = st["reflected"] + st["transmitted"]
+    return {
+        "scene": label, "triangles": int(st["triangles"]), "grid": g, "levels": levels,
+        "cells": st["grid"],
+        "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
+        "shading_mrays_s": (f"{(st['rays_primary'] + st['rays_shadow']) / ((st['shading_ms'] + st['tree_ms']) * 1e3):.2f}"
+                            if st["shading_ms"] > 0 else ""),
+        "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
+                              if st["tree_ms"] > 0 else ""),
+        "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
+        "kernel_ms": f"{kern:.1f}",
+    }
+
+
 def part_grid(a, out):
     scenes = GRID_SCENES_QUICK if a.quick else GRID_SCENES
     sizes = GRID_SIZES_QUICK if a.quick else GRID_SIZES
@@ -200,27 +220,17 @@ def part_grid(a, out):
     for label, scene, extra in scenes:
         run_stats(a.vbcl, scene, ["--width", "8", "--height", "8"] + extra)  # warm
         for g in sizes:
-            opts = ["--width", str(size), "--height", str(size), "--grid", g,
-                    "-o", os.path.join(a.tmp, "grid.exr")] + extra
-            st = median_stats(a.vbcl, scene, opts, a.repeats)
-            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
-            secondary = st["reflected"] + st["transmitted"]
-            row = {
-                "scene": label, "triangles": int(st["triangles"]), "grid": g,
-                "cells": st["grid"],
-                "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
-                "shading_mrays_s": (f"{(st['rays_primary'] + st['rays_shadow']) / ((st['shading_ms'] + st['tree_ms']) * 1e3):.2f}"
-                                    if st["shading_ms"] > 0 else ""),
-                "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
-                                      if st["tree_ms"] > 0 else ""),
-                "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
-                "kernel_ms": f"{kern:.1f}",
-            }
-            rows.append(row)
-            print(f"grid: {row}", flush=True)
-    fields = ["scene", "triangles", "grid", "cells", "primary_mrays_s", "shading_mrays_s",
-              "secondary_mrays_s", "all_mrays_s", "kernel_ms"]
-    note = (f"{size}x{size}, median of {a.repeats}. primary: camera rays over the intersect "
+            for levels, suffix in GRID_LEVELS:
+                opts = ["--width", str(size), "--height", str(size), "--grid", g + suffix,
+                        "-o", os.path.join(a.tmp, "grid.exr")] + extra
+                row = grid_row(label, g, levels, median_stats(a.vbcl, scene, opts, a.repeats))
+                rows.append(row)
+                print(f"grid: {row}", flush=True)
+    fields = ["scene", "triangles", "grid", "levels", "cells", "primary_mrays_s",
+              "shading_mrays_s", "secondary_mrays_s", "all_mrays_s", "kernel_ms"]
+    note = (f"{size}x{size}, median of {a.repeats}. grid: the top level (`--grid N`); levels: "
+            "two = with automatic sub-grids in crowded top cells, one = `--grid N:1`. primary: "
+            "camera rays over the intersect "
             "kernel's time; shading: primary rays plus all shadow feelers over the shading and "
             "ray-tree kernels' time; secondary: reflected and transmitted rays over the "
             "ray-tree kernel's time (which also traces their feelers); all: every ray over "
@@ -229,13 +239,14 @@ def part_grid(a, out):
                        "Throughput across grid sizes", note)
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 3.8), squeeze=False)
     for ax, (label, _, _) in zip(axes[0], scenes):
-        rs = [r for r in rows if r["scene"] == label]
-        xs = list(range(len(rs)))
-        ax.plot(xs, [float(r["all_mrays_s"]) for r in rs], "o-", label="all rays")
-        ax.plot(xs, [float(r["primary_mrays_s"]) for r in rs], "s--", label="primary")
+        for levels, style in (("two", "o-"), ("one", "s--")):
+            rs = [r for r in rows if r["scene"] == label and r["levels"] == levels]
+            xs = list(range(len(rs)))
+            ax.plot(xs, [float(r["all_mrays_s"]) for r in rs], style,
+                    label=f"all rays, {levels} level{'s' if levels == 'two' else ''}")
         ax.set_xticks(xs)
         ax.set_xticklabels([r["grid"] for r in rs], fontsize=8)
-        ax.set_xlabel("grid (cells per axis)")
+        ax.set_xlabel("top-level grid (cells per axis)")
         ax.set_ylabel("Mrays/s")
         ax.set_yscale("log")
         ax.set_title(label, fontsize=9)

@@ -106,11 +106,13 @@ static void test_cli_renders_and_overrides(void)
     const char *scene = tu_write_file("good.json", GOOD_SCENE);
     char out[8192], args[2048], img[512];
     snprintf(img, sizeof img, "%s/good.exr", tu_tmpdir());
-    snprintf(args, sizeof args, "%s -o %s --width 20 --height 10 --grid 4 --stats", scene, img);
+    snprintf(args, sizeof args, "%s -o %s --width 20 --height 10 --grid 4:2,3,1 --stats", scene,
+             img);
     int rc = vbcl(args, out, sizeof out);
     CHECK(rc == 0, "render exits 0 (%d): %s", rc, out);
     CHECK(strstr(out, "(20x10)") != NULL, "command line overrides the size: %s", out);
     CHECK(strstr(out, "4x4x4") != NULL, "command line overrides the grid: %s", out);
+    CHECK(strstr(out, "sub-grids") && strstr(out, "(given)"), "--grid TOP:SUB given: %s", out);
     CHECK(strstr(out, "rays        primary 200") != NULL, "--stats counts primary rays: %s", out);
     CHECK(file_exists(img), "image written");
     /* every output format, read back: 8-bit sRGB ones and linear float EXR agree */
@@ -315,6 +317,7 @@ static void test_cli_bad_input_classes(void)
         " \"profile\": [[0, 0], [1, 1]]}]}",
         NULL, "segments");                               /* absurd count */
     expect_bad(GOOD_SCENE, "--grid 0", "--grid");        /* bad option */
+    expect_bad(GOOD_SCENE, "--grid 4:65", "SUB 1..64");  /* sub-grid too fine */
     expect_bad(GOOD_SCENE, "--width 100000", "--width"); /* absurd image size */
     /* unreadable mesh: the tests run as root, so a directory stands in for a file */
     char dirpath[512];

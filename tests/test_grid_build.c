@@ -432,6 +432,164 @@ static void test_build_meshes(void)
     mesh_release(&meshes[1]);
 }
 
+/* Whether triangle t is listed in leaf l (binary search in its ascending list). */
+static int leaf_lists(const Grid *g, uint32_t l, uint32_t t)
+{
+    uint32_t a = g->leaf_start[l], b = g->leaf_start[l + 1];
+    while (a < b) {
+        uint32_t mid = a + (b - a) / 2;
+        if (g->leaf_tris[mid] == t) return 1;
+        if (g->leaf_tris[mid] < t)
+            a = mid + 1;
+        else
+            b = mid;
+    }
+    return 0;
+}
+
+/* The sub-grid resolution grid_build_leaves must give a top cell of k triangles. */
+static void want_sub_res(const Grid *g, uint32_t k, const int sub[3], float density, int n[3])
+{
+    n[0] = n[1] = n[2] = 1;
+    if (sub) {
+        if (k >= 2) memcpy(n, sub, sizeof(int) * 3);
+    } else if (k >= GRID_SUB_MIN_TRIS) {
+        const float lo[3] = {0.0f, 0.0f, 0.0f};
+        grid_auto_resolution(lo, g->cell, k, density, n);
+        for (int a = 0; a < 3; a++) n[a] = n[a] > GRID_SUB_MAX_AXIS ? GRID_SUB_MAX_AXIS : n[a];
+    }
+}
+
+/* Checks the leaves of top cell c (index ix) of a sub-grid n: every triangle of the cell
+ * that the clipping reference finds overlapping a sub-cell is listed there, and every
+ * listed one nearly overlaps it. Returns the number of failures. */
+static uint32_t check_subgrid(const Grid *g, const Mesh *m, const int ix[3], const int n[3],
+                              double ref, const char *label)
+{
+    uint32_t c = cell_index(g, ix), first = g->cells[2 * c], bad = 0;
+    double tc[3], th[3], p[3][3];
+    cell_box(g, ix, tc, th);
+    for (int z = 0; z < n[2]; z++)
+        for (int y = 0; y < n[1]; y++)
+            for (int x = 0; x < n[0]; x++) {
+                int sx[3] = {x, y, z};
+                double sc[3], sh[3];
+                for (int a = 0; a < 3; a++) {
+                    sh[a] = th[a] / n[a];
+                    sc[a] = tc[a] - th[a] + (2 * sx[a] + 1) * sh[a];
+                }
+                uint32_t l = first + (uint32_t)(x + n[0] * (y + n[1] * z));
+                for (uint32_t i = g->cell_start[c]; i < g->cell_start[c + 1]; i++) {
+                    tri_get(m, g->cell_tris[i], p);
+                    if (clip_overlap(sc, sh, p, -1e-9 * ref) &&
+                        !leaf_lists(g, l, g->cell_tris[i])) {
+                        bad++;
+                        CHECK(0,
+                              "%s: triangle %u overlaps sub-cell (%d %d %d) of cell %u but is "
+                              "not listed",
+                              label, g->cell_tris[i], x, y, z, c);
+                    }
+                }
+                double grow = 1e-4 * fmax(sh[0], fmax(sh[1], sh[2])) + 1e-5 * ref;
+                for (uint32_t i = g->leaf_start[l]; i < g->leaf_start[l + 1]; i++) {
+                    tri_get(m, g->leaf_tris[i], p);
+                    if (!grid_lists(g, c, g->leaf_tris[i]) || !clip_overlap(sc, sh, p, grow)) {
+                        bad++;
+                        CHECK(0,
+                              "%s: triangle %u listed in sub-cell (%d %d %d) of cell %u, which "
+                              "it does not touch",
+                              label, g->leaf_tris[i], x, y, z, c);
+                    }
+                }
+            }
+    return bad;
+}
+
+/* Checks the second level of g, built with sub (NULL: auto) and density: the layout (leaves
+ * in top-cell order, each resolution as the rule says, lists ascending), a plain list equal
+ * to its top cell's, and every sub-grid exact and complete (check_subgrid). */
+static void check_leaves(const Grid *g, const Mesh *m, const int sub[3], float density,
+                         const char *label)
+{
+    uint64_t leaves = 0;
+    uint32_t subgrids = 0, bad = 0, maxl = 0;
+    double ref = 0.0;
+    for (int a = 0; a < 3; a++) ref = fmax(ref, (double)g->hi[a] - g->lo[a]);
+    for (uint32_t l = 0; l < g->nleaves; l++) {
+        uint32_t a = g->leaf_start[l], b = g->leaf_start[l + 1];
+        CHECK(a <= b, "%s: leaf_start decreases at leaf %u", label, l);
+        if (a > b) return;
+        maxl = b - a > maxl ? b - a : maxl;
+        for (uint32_t i = a + 1; i < b; i++) bad += g->leaf_tris[i] <= g->leaf_tris[i - 1];
+    }
+    CHECK(bad == 0, "%s: %u leaf entries not ascending", label, bad);
+    CHECK(g->leaf_start[0] == 0 && g->leaf_start[g->nleaves] == g->nleaf_refs,
+          "%s: leaf offsets %u .. %u for %u references", label, g->leaf_start[0],
+          g->leaf_start[g->nleaves], g->nleaf_refs);
+    CHECK(maxl == g->tris_per_leaf_max, "%s: max %u per leaf, recount %u", label,
+          g->tris_per_leaf_max, maxl);
+    for (int z = 0; z < g->n[2]; z++)
+        for (int y = 0; y < g->n[1]; y++)
+            for (int x = 0; x < g->n[0]; x++) {
+                int ix[3] = {x, y, z}, n[3], want[3];
+                uint32_t c = cell_index(g, ix), k = g->cell_start[c + 1] - g->cell_start[c];
+                grid_sub_unpack(g->cells[2 * c + 1], n);
+                want_sub_res(g, k, sub, density, want);
+                CHECK(g->cells[2 * c] == leaves && memcmp(n, want, sizeof n) == 0,
+                      "%s: cell %u (%u triangles): first leaf %u (want %llu), %dx%dx%d (want "
+                      "%dx%dx%d)",
+                      label, c, k, g->cells[2 * c], (unsigned long long)leaves, n[0], n[1], n[2],
+                      want[0], want[1], want[2]);
+                if (g->cells[2 * c] != leaves || memcmp(n, want, sizeof n)) return;
+                leaves += (uint64_t)n[0] * n[1] * n[2];
+                if (n[0] * n[1] * n[2] > 1) {
+                    subgrids++;
+                    bad += check_subgrid(g, m, ix, n, ref, label);
+                    continue;
+                }
+                uint32_t l = g->cells[2 * c];
+                CHECK(g->leaf_start[l + 1] - g->leaf_start[l] == k &&
+                          memcmp(g->leaf_tris + g->leaf_start[l], g->cell_tris + g->cell_start[c],
+                                 sizeof(uint32_t) * k) == 0,
+                      "%s: cell %u without a sub-grid: its leaf is not its list", label, c);
+            }
+    CHECK(leaves == g->nleaves && subgrids == g->subgrids,
+          "%s: %llu leaves (%u), %u sub-grids (%u)", label, (unsigned long long)leaves, g->nleaves,
+          subgrids, g->subgrids);
+    CHECK(bad == 0, "%s: %u sub-grid failures", label, bad);
+}
+
+/* Two-level grids over random triangles and a sphere: top levels 1, 3x2x5 and auto, each
+ * with auto sub-grids (density 2 and 16) and a given 3x1x4: layout, rules, and exact,
+ * complete leaves (check_leaves); one top cell of a 1x1x1 grid becomes a sub-grid. */
+static void test_build_leaves(void)
+{
+    const double centre[3] = {3.0, -2.0, 5.0};
+    const float sc[3] = {0.3f, 0.1f, -0.2f};
+    Mesh meshes[2] = {mesh_random(600, centre, 11), mesh_sphere(16, 32, 1.5f, sc)};
+    const int top[3][3] = {{1, 1, 1}, {3, 2, 5}, {0, 0, 0}}, fixed[3] = {3, 1, 4};
+    for (int mi = 0; mi < 2; mi++)
+        for (int ti = 0; ti < 3; ti++)
+            for (int si = 0; si < 3; si++) {
+                Grid g;
+                char err[256] = "", label[96];
+                const int *sub = si == 2 ? fixed : NULL;
+                float density = si == 1 ? 16.0f : 2.0f;
+                snprintf(label, sizeof label, "%s top %dx%dx%d sub %s density %g",
+                         mi ? "sphere" : "random", top[ti][0], top[ti][1], top[ti][2],
+                         sub ? "3x1x4" : "auto", (double)density);
+                int rc = grid_build(&g, &meshes[mi], top[ti], 0.0f, err, sizeof err);
+                if (!rc) rc = grid_build_leaves(&g, &meshes[mi], sub, density, err, sizeof err);
+                CHECK(rc == 0, "%s: build failed: %s", label, err);
+                if (rc == 0) check_leaves(&g, &meshes[mi], sub, density, label);
+                if (ti == 0 && rc == 0)
+                    CHECK(g.subgrids == 1, "%s: the one top cell has no sub-grid", label);
+                grid_free(&g);
+            }
+    mesh_release(&meshes[0]);
+    mesh_release(&meshes[1]);
+}
+
 /* Checks that triangle t, which lies on the boundary plane between layers k-1 and k of
  * axis `axis`, is listed on both sides wherever it meets a cell's face, and nowhere else. */
 static void check_boundary_tri(const Grid *g, const Mesh *m, uint32_t t, int axis, int k,
@@ -829,6 +987,7 @@ void suite_grid_build(void)
     RUN_TEST(test_overlap_cases);
     RUN_TEST(test_overlap_random);
     RUN_TEST(test_build_meshes);
+    RUN_TEST(test_build_leaves);
     RUN_TEST(test_boundary_planes);
     RUN_TEST(test_auto_resolution);
     RUN_TEST(test_auto_stadium);

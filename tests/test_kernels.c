@@ -133,8 +133,10 @@ static void compare_grid_brute(const char *label, const char *json, const char *
         }
     }
     fprintf(stderr,
-            "    %s, grid %s (%dx%dx%d): %d rays, %d hit, %d ties at equal t, %d mismatches\n",
-            label, grid, fx.r.grid.n[0], fx.r.grid.n[1], fx.r.grid.n[2], n, hits, ties, bad);
+            "    %s, grid %s (%dx%dx%d, %u sub-grids, %u leaves): %d rays, %d hit, %d ties at "
+            "equal t, %d mismatches\n",
+            label, grid, fx.r.grid.n[0], fx.r.grid.n[1], fx.r.grid.n[2], fx.r.grid.subgrids,
+            fx.r.grid.nleaves, n, hits, ties, bad);
     CHECK(hits > n / 10, "%s: enough rays hit (%d of %d)", label, hits, n);
     CHECK(ties < n / 1000 + 5, "%s: ties are rare (%d)", label, ties);
     free(rays);
@@ -145,9 +147,39 @@ static void compare_grid_brute(const char *label, const char *json, const char *
 
 #define CAM "\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
 
+/* Writes soup.obj: n random triangles in [-2, 2]^3, every eighth one large (up to the
+ * scene's size, spanning many cells in front of and behind small ones), the rest small. */
+static void write_triangle_soup(int n, unsigned seed)
+{
+    size_t cap = (size_t)n * 200 + 64, len = 0;
+    char *text = malloc(cap);
+    for (int i = 0; i < n; i++) {
+        float c[3], size = (i % 8 == 0) ? 3.0f : 0.3f;
+        for (int a = 0; a < 3; a++) c[a] = 4.0f * frand(&seed) - 2.0f;
+        for (int v = 0; v < 3; v++) {
+            float p[3];
+            for (int a = 0; a < 3; a++) {
+                p[a] = c[a] + size * (frand(&seed) - 0.5f);
+                p[a] = p[a] < -2.0f ? -2.0f : p[a] > 2.0f ? 2.0f : p[a];
+            }
+            len += (size_t)snprintf(text + len, cap - len, "v %.6f %.6f %.6f\n", (double)p[0],
+                                    (double)p[1], (double)p[2]);
+        }
+    }
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(text + len, cap - len, "f %d %d %d\n", 3 * i + 1, 3 * i + 2,
+                                3 * i + 3);
+    tu_write_file("soup.obj", text);
+    free(text);
+}
+
+/* The two-level grid against brute force, 10^6 rays in all: top levels 1, auto, 64^3 and
+ * 7x3x19 with automatic sub-grids; given sub-grids (a 3x1x7 in every crowded cell, dense
+ * ones); one level only (subgrid 1); boxes whose faces lie on top-cell and sub-cell faces;
+ * a flat scene; a soup of large triangles spanning many cells among small ones. The %s of each
+ * scene is the render object's grid entries. */
 static void test_grid_matches_brute_force(void)
 {
-    /* %s is the grid resolution */
     static const char *spheres =
         "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
         "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"
@@ -162,12 +194,140 @@ static void test_grid_matches_brute_force(void)
         "2.2]]},"
         "{\"shape\": \"prism\", \"depth\": 3, \"material\": \"m\", \"transform\": {\"scale\": 2}},"
         "{\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"m\"}]}";
+    /* unit boxes tiling [-1, 1]^3 (faces at -1, 0, 1: top-cell faces of grids 2 and 4) and
+     * half boxes with faces at +-0.5 (sub-cell faces of grid 2 with 2x2x2 sub-grids) */
+    static const char *faces =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [0.5, 0.5, "
+        "0.5]}},"
+        "{\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [-0.5, 0.5, "
+        "-0.5]}},"
+        "{\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [-0.5, -0.5, "
+        "0.5]}},"
+        "{\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [0.5, -0.5, "
+        "-0.5]}},"
+        "{\"shape\": \"box\", \"size\": [0.5, 0.5, 0.5], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [0.25, -0.25, 0.75]}},"
+        "{\"shape\": \"box\", \"size\": [0.5, 1, 0.5], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [-0.75, 0, 0.25]}}]}";
+    /* one plane of quads and a disc of revolution in it: a flat scene */
+    static const char *flat =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"quad\", \"size\": [4, 4], \"material\": \"m\"},"
+        "{\"shape\": \"quad\", \"size\": [1, 1], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [2.5, 0, 0.5]}},"
+        "{\"shape\": \"revolution\", \"segments\": 64, \"material\": \"m\", \"transform\": "
+        "{\"translate\": [-2.5, 0, -2]}, \"profile\": [[0, 0], [0.5, 0], [1, 0]]}]}";
+    static const char *soup =
+        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"mesh\", \"file\": \"soup.obj\", \"material\": \"m\"}]}";
+    write_triangle_soup(400, 99u);
+    compare_grid_brute("triangle soup", soup, "3", 100000);
+    compare_grid_brute("triangle soup", soup, "\"auto\"", 100000);
     static const char *grids[] = {"1", "\"auto\"", "64"};
     for (int g = 0; g < 3; g++) {
         compare_grid_brute("spheres and a slab", spheres, grids[g], 100000);
         compare_grid_brute("vase, prism and floor", vase, grids[g], 100000);
     }
     compare_grid_brute("spheres and a slab", spheres, "[7, 3, 19]", 100000);
+    compare_grid_brute("spheres and a slab", spheres, "5, \"subgrid\": [3, 1, 7]", 100000);
+    compare_grid_brute("vase, prism and floor", vase, "\"auto\", \"subgrid\": 1", 100000);
+    compare_grid_brute("vase, prism and floor", vase, "2, \"subgrid_density\": 16", 100000);
+    compare_grid_brute("boxes on cell faces", faces, "2, \"subgrid\": 2", 100000);
+    compare_grid_brute("boxes on cell faces", faces, "4, \"subgrid\": [2, 4, 1]", 50000);
+    compare_grid_brute("flat scene", flat, "\"auto\"", 50000);
+    compare_grid_brute("flat scene", flat, "[4, 1, 4], \"subgrid\": [8, 1, 8]", 50000);
+}
+
+/* grid_cell_box_range: for random boxes in random top cells (mostly inside the cell, some
+ * crossing its faces, some flat), the leaves it gives hold every triangle of the cell that
+ * overlaps the box within the cell (exact test on the host), only triangles of the cell, and
+ * fewer than the whole list where the cell has a sub-grid and the box is small. */
+static void test_grid_cell_box_range(void)
+{
+    static const char *json =
+        "{" CAM "\"render\": {\"grid\": 3}, \"materials\": {\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"
+        "{\"shape\": \"box\", \"size\": [6, 0.2, 6], \"material\": \"m\", \"transform\": "
+        "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}";
+    Fixture fx;
+    if (fixture_open(&fx, json)) return;
+    const Grid *g = &fx.r.grid;
+    enum { NQ = 2000 };
+    cl_uint ntris = fx.s.mesh.ntris, nq = NQ;
+    float *q = calloc(12 * NQ, sizeof *q);
+    unsigned char *mark = calloc((size_t)NQ * ntris, 1);
+    unsigned seed = 4242u;
+    for (int i = 0; i < NQ; i++) {
+        float *p = q + 12 * i;
+        for (int a = 0; a < 3; a++) {
+            int c = (int)(frand(&seed) * g->n[a]);
+            p[a] = (float)(c < g->n[a] ? c : g->n[a] - 1);
+            float lo = g->lo[a] + p[a] * g->cell[a];
+            float u = frand(&seed) * 1.2f - 0.1f, w = (i % 7 == 0) ? 0.0f : 0.3f * frand(&seed);
+            p[4 + a] = lo + u * g->cell[a];
+            p[8 + a] = lo + (u + w) * g->cell[a];
+        }
+    }
+    cl_mem mf = buffer(&fx.r.frame_host, sizeof fx.r.frame_host), mq = buffer(q, 12 * NQ * 4);
+    cl_mem mm = buffer(mark, (size_t)NQ * ntris);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem),  sizeof(cl_mem),  sizeof(cl_mem),
+                         sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_uint), sizeof(cl_mem)};
+    const void *v[] = {
+        &mf, &fx.r.buf.grid_cells, &fx.r.buf.leaf_start, &fx.r.buf.leaf_tris, &mq, &nq, &ntris,
+        &mm};
+    run_kernel(fx.r.program, "probe_grid_box_range", NQ, 8, sz, v);
+    read_buffer(mm, mark, (size_t)NQ * ntris);
+    int missing = 0, foreign = 0, restricted = 0, crowded = 0;
+    for (int i = 0; i < NQ; i++) {
+        const float *p = q + 12 * i;
+        uint32_t c =
+            (uint32_t)p[0] + (uint32_t)g->n[0] * ((uint32_t)p[1] + g->n[1] * (uint32_t)p[2]);
+        float centre[3], half[3];
+        int empty = 0;
+        for (int a = 0; a < 3; a++) { /* the box within the cell */
+            float lo = g->lo[a] + p[a] * g->cell[a], hi = lo + g->cell[a];
+            float b0 = fmaxf(p[4 + a], lo), b1 = fminf(p[8 + a], hi);
+            empty |= b0 > b1;
+            centre[a] = 0.5f * (b0 + b1);
+            half[a] = 0.5f * (b1 - b0);
+        }
+        uint32_t in_list = 0, marked = 0;
+        for (uint32_t t = 0; t < ntris; t++) {
+            int listed = 0;
+            for (uint32_t k = g->cell_start[c]; k < g->cell_start[c + 1] && !listed; k++)
+                listed = g->cell_tris[k] == t;
+            in_list += listed;
+            marked += mark[(size_t)i * ntris + t];
+            foreign += mark[(size_t)i * ntris + t] && !listed;
+            if (!listed || empty || mark[(size_t)i * ntris + t]) continue;
+            float tri[3][3];
+            for (int k = 0; k < 3; k++) {
+                vec3 pt = fx.s.mesh.verts[fx.s.mesh.tris[3 * t + (uint32_t)k]];
+                tri[k][0] = pt.x, tri[k][1] = pt.y, tri[k][2] = pt.z;
+            }
+            if (grid_tri_box_overlap(centre, half, tri) && ++missing <= 5)
+                CHECK(0, "query %d: triangle %u overlaps the box in cell %u but was not visited", i,
+                      t, c);
+        }
+        int n[3];
+        grid_sub_unpack(g->cells[2 * c + 1], n);
+        crowded += n[0] * n[1] * n[2] > 1;
+        restricted += n[0] * n[1] * n[2] > 1 && marked < in_list;
+    }
+    fprintf(stderr,
+            "    %d queries: %d in cells with a sub-grid, %d of them visiting part of the "
+            "list; %d triangles missed, %d from other cells\n",
+            NQ, crowded, restricted, missing, foreign);
+    CHECK(missing == 0 && foreign == 0, "%d triangles missed, %d foreign", missing, foreign);
+    CHECK(crowded > NQ / 10 && restricted > crowded / 2,
+          "the boxes restrict too rarely: %d of %d queries in sub-grids", restricted, crowded);
+    clReleaseMemObject(mf);
+    clReleaseMemObject(mq);
+    clReleaseMemObject(mm);
+    free(q);
+    free(mark);
+    fixture_close(&fx);
 }
 
 /* A glass box standing on an opaque floor: its bottom face lies in the floor's plane.
@@ -384,6 +544,7 @@ void suite_kernels(void)
     RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
+    RUN_TEST(test_grid_cell_box_range);
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);

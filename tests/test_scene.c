@@ -273,6 +273,44 @@ static void test_scene_parse_grid(void)
                  "use \"auto\" or fewer cells");
 }
 
+/* Both levels of the grid: TOP[:SUB] on the command line, render.subgrid in a scene. */
+static void test_scene_parse_grid_levels(void)
+{
+    int r[3] = {9, 9, 9}, sub[3] = {7, 7, 7};
+    CHECK(scene_parse_grid_levels("20", r, sub) == 0 && r[0] == 20 && sub[0] == 7,
+          "TOP alone leaves SUB");
+    CHECK(scene_parse_grid_levels("20:1", r, sub) == 0 && r[2] == 20 && sub[0] == 1 &&
+              sub[1] == 1 && sub[2] == 1,
+          "20:1");
+    CHECK(scene_parse_grid_levels("auto:3,1,4", r, sub) == 0 && r[0] == 0 && sub[0] == 3 &&
+              sub[1] == 1 && sub[2] == 4,
+          "auto:3,1,4");
+    CHECK(scene_parse_grid_levels("8,2,8:auto", r, sub) == 0 && r[1] == 2 && sub[0] == 0,
+          "8,2,8:auto");
+    CHECK(scene_parse_grid_levels("20:", r, sub) == -1, "empty SUB rejected");
+    CHECK(scene_parse_grid_levels(":4", r, sub) == -1, "empty TOP rejected");
+    CHECK(scene_parse_grid_levels("20:65", r, sub) == -1, "SUB above 64 rejected");
+    CHECK(scene_parse_grid_levels("20:0", r, sub) == -1, "SUB 0 rejected");
+    CHECK(scene_parse_grid_levels("20:4:4", r, sub) == -1, "three levels rejected");
+    CHECK(r[0] == 8 && sub[0] == 0, "a rejected text leaves both untouched");
+    Scene s;
+    char err[1024] = "";
+    int rc = load_text(
+        MIN_SCENE_HEAD
+        " \"render\": {\"grid\": 20, \"subgrid\": [2, 3, 4], "
+        "\"subgrid_density\": 5}, \"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}",
+        &s, err, sizeof err);
+    CHECK(rc == 0 && s.subgrid_res[0] == 2 && s.subgrid_res[2] == 4 && s.subgrid_density == 5.0f,
+          "render.subgrid: %s", err);
+    if (rc == 0) scene_free(&s);
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"subgrid\": 65}}",
+                 "scene.json: render.subgrid", "64");
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"render\": {\"subgrid\": \"fine\"}}",
+                 "scene.json: render.subgrid", "expected \"auto\"");
+}
+
 /* A texture generated inline from texgen's arguments: generated once into the cache,
  * read from it the next time; bad arguments give the JSON path and texgen's reason. */
 static void test_scene_texture_generate_inline(void)
@@ -568,4 +606,5 @@ void suite_scene(void)
     RUN_TEST(test_scene_empty_and_missing);
     RUN_TEST(test_scene_bad_mesh_files);
     RUN_TEST(test_scene_parse_grid);
+    RUN_TEST(test_scene_parse_grid_levels);
 }

@@ -1,5 +1,6 @@
-/* grid.c — builds the uniform grid: padded bounds, resolution, exact triangle/cell overlap
- * (separating axes in double), and the compact layout in two passes (count, then fill). */
+/* grid.c — builds the two-level grid: padded bounds, resolution, exact triangle/cell overlap
+ * (separating axes in double), the top level's compact layout in two passes (count, then
+ * fill), and the sub-grids of its crowded cells in the same two passes. */
 #include "grid.h"
 
 #include <float.h>
@@ -215,9 +216,10 @@ static double grid_set_bounds(Grid *g, const double blo[3], const double bhi[3])
     return ref;
 }
 
-/* Visits the cells that triangle t overlaps: counts them into cnt (out == NULL), or writes t
- * at cnt[cell]++ into out. Adds the number of cells to *total. */
-static void grid_visit(const Grid *g, const GridCtx *x, const double t[3][3], uint32_t ti,
+/* Visits the cells of a grid of n[] cells (x: its origin, cell size and enlargement) that
+ * triangle t overlaps: counts them into cnt (out == NULL), or writes t at cnt[cell]++ into
+ * out. Adds the number of cells to *total. */
+static void grid_visit(const int n[3], const GridCtx *x, const double t[3][3], uint32_t ti,
                        uint32_t *cnt, uint32_t *out, uint64_t *total)
 {
     int r0[3], r1[3];
@@ -226,8 +228,8 @@ static void grid_visit(const Grid *g, const GridCtx *x, const double t[3][3], ui
         double b = dmax(t[0][i], dmax(t[1][i], t[2][i]));
         double f0 = floor((a - x->lo[i] - 2.0 * x->reach) / x->cs[i]);
         double f1 = floor((b - x->lo[i] + 2.0 * x->reach) / x->cs[i]);
-        r0[i] = f0 < 0.0 ? 0 : f0 > g->n[i] - 1 ? g->n[i] - 1 : (int)f0;
-        r1[i] = f1 < 0.0 ? 0 : f1 > g->n[i] - 1 ? g->n[i] - 1 : (int)f1;
+        r0[i] = f0 < 0.0 ? 0 : f0 > n[i] - 1 ? n[i] - 1 : (int)f0;
+        r1[i] = f1 < 0.0 ? 0 : f1 > n[i] - 1 ? n[i] - 1 : (int)f1;
     }
     /* A bounding box inside one cell needs no test: the triangle lies in it. */
     int single = r0[0] == r1[0] && r0[1] == r1[1] && r0[2] == r1[2];
@@ -238,7 +240,7 @@ static void grid_visit(const Grid *g, const GridCtx *x, const double t[3][3], ui
         c[2] = x->lo[2] + (z + 0.5) * x->cs[2];
         for (int y = r0[1]; y <= r1[1]; y++) {
             c[1] = x->lo[1] + (y + 0.5) * x->cs[1];
-            uint32_t row = (uint32_t)g->n[0] * ((uint32_t)y + (uint32_t)g->n[1] * (uint32_t)z);
+            uint32_t row = (uint32_t)n[0] * ((uint32_t)y + (uint32_t)n[1] * (uint32_t)z);
             for (int xi = r0[0]; xi <= r1[0]; xi++) {
                 c[0] = x->lo[0] + (xi + 0.5) * x->cs[0];
                 if (!single && !sat_overlap(&s, c)) continue;
@@ -277,6 +279,7 @@ static void grid_ctx_init(Grid *g, double ref, GridCtx *x)
     /* Conservative cells: a hair of the scene size and of float resolution at its
      * coordinates, plus 1e-5 of the cell, so faces on a cell boundary list on both sides. */
     x->reach = 1e-6 * ref + 2.0 * FLT_EPSILON * maxabs;
+    g->reach = x->reach;
     for (int i = 0; i < 3; i++) x->half[i] = 0.5 * x->cs[i] + 1e-5 * x->cs[i] + x->reach;
     x->reach += 1e-5 * fmax(x->cs[0], fmax(x->cs[1], x->cs[2]));
 }
@@ -291,7 +294,7 @@ static uint64_t grid_count(const Grid *g, const GridCtx *x, const Mesh *m, uint3
     double tri[3][3];
     for (uint32_t t = 0; t < m->ntris; t++) {
         grid_triangle(m, t, tri);
-        grid_visit(g, x, tri, t, cnt, NULL, &total);
+        grid_visit(g->n, x, tri, t, cnt, NULL, &total);
     }
     for (uint32_t c = 0; c < g->ncells; c++) ne += cnt[c] != 0;
     *nonempty = ne;
@@ -452,7 +455,7 @@ static uint32_t grid_fill_pass(Grid *g, const Mesh *m, const GridCtx *x)
     double tri[3][3];
     for (uint32_t t = 0; t < m->ntris; t++) {
         grid_triangle(m, t, tri);
-        grid_visit(g, x, tri, t, g->cell_start, g->cell_tris, &total);
+        grid_visit(g->n, x, tri, t, g->cell_start, g->cell_tris, &total);
     }
     memmove(g->cell_start + 1, g->cell_start, (size_t)g->ncells * sizeof *g->cell_start);
     g->cell_start[0] = 0;
@@ -501,9 +504,172 @@ int grid_build_tuned(Grid *g, const Mesh *m, const int res[3], float density, fl
     return 0;
 }
 
+/* The sub-grid resolution n of a top cell holding k triangles (see grid_build_leaves). */
+static void leaves_resolution(const Grid *g, uint32_t k, const int sub_res[3], float density,
+                              int n[3])
+{
+    n[0] = n[1] = n[2] = 1;
+    if (sub_res) {
+        if (k >= 2) memcpy(n, sub_res, 3 * sizeof *n);
+        return;
+    }
+    if (k < GRID_SUB_MIN_TRIS) return;
+    float lo[3] = {0.0f, 0.0f, 0.0f};
+    grid_auto_resolution(lo, g->cell, k, density, n);
+    for (int i = 0; i < 3; i++) n[i] = n[i] > GRID_SUB_MAX_AXIS ? GRID_SUB_MAX_AXIS : n[i];
+}
+
+/* The build context of top cell c's sub-grid of n[] cells: its box and sub-cell size from
+ * the top level's (x), each sub-cell enlarged by 1e-5 of itself plus three times the top
+ * level's rounding reach (the kernels compute a sub-cell's bounds from the top cell's in
+ * float, a few more roundings than the top level's own). */
+static void leaves_ctx(const Grid *g, const GridCtx *x, uint32_t c, const int n[3], GridCtx *sx)
+{
+    uint32_t idx[3] = {c % (uint32_t)g->n[0], c / (uint32_t)g->n[0] % (uint32_t)g->n[1],
+                       c / ((uint32_t)g->n[0] * (uint32_t)g->n[1])};
+    double big = 0.0;
+    for (int i = 0; i < 3; i++) {
+        sx->lo[i] = x->lo[i] + idx[i] * x->cs[i];
+        sx->cs[i] = x->cs[i] / n[i];
+        big = fmax(big, sx->cs[i]);
+    }
+    for (int i = 0; i < 3; i++) sx->half[i] = 0.5 * sx->cs[i] + 1e-5 * sx->cs[i] + 3.0 * g->reach;
+    sx->reach = 3.0 * g->reach + 1e-5 * big;
+}
+
+/* One pass over the top cells: each cell's triangles into its leaves, counted into cnt
+ * (out == NULL) or written at out[cnt[leaf]++]. Returns the number of references. */
+static uint64_t leaves_pass(const Grid *g, const Mesh *m, uint32_t *cnt, uint32_t *out)
+{
+    GridCtx x;
+    uint64_t total = 0;
+    double tri[3][3];
+    for (int i = 0; i < 3; i++) {
+        x.lo[i] = g->lo[i];
+        x.cs[i] = ((double)g->hi[i] - (double)g->lo[i]) / g->n[i];
+    }
+    for (uint32_t c = 0; c < g->ncells; c++) {
+        uint32_t first = g->cells[2 * c], b = g->cell_start[c], e = g->cell_start[c + 1];
+        int n[3];
+        grid_sub_unpack(g->cells[2 * c + 1], n);
+        if (n[0] * n[1] * n[2] == 1) {
+            for (uint32_t k = b; k < e; k++)
+                if (out)
+                    out[cnt[first]++] = g->cell_tris[k];
+                else
+                    cnt[first]++;
+            total += e - b;
+            continue;
+        }
+        GridCtx sx;
+        leaves_ctx(g, &x, c, n, &sx);
+        for (uint32_t k = b; k < e; k++) {
+            grid_triangle(m, g->cell_tris[k], tri);
+            grid_visit(n, &sx, tri, g->cell_tris[k], cnt + first, out, &total);
+        }
+    }
+    return total;
+}
+
+static void grid_leaves_free(Grid *g)
+{
+    free(g->cells);
+    free(g->leaf_start);
+    free(g->leaf_tris);
+    g->cells = g->leaf_start = g->leaf_tris = NULL;
+    g->nleaves = g->nleaf_refs = g->subgrids = g->tris_per_leaf_max = 0;
+}
+
+/* Every top cell's sub-grid resolution and first leaf into g->cells. Returns the number
+ * of leaves. */
+static uint64_t leaves_layout(Grid *g, const int sub_res[3], float density)
+{
+    uint64_t nleaves = 0;
+    g->subgrids = 0;
+    for (uint32_t c = 0; c < g->ncells; c++) {
+        int n[3];
+        leaves_resolution(g, g->cell_start[c + 1] - g->cell_start[c], sub_res, density, n);
+        g->cells[2 * c] = (uint32_t)(nleaves < UINT32_MAX ? nleaves : UINT32_MAX);
+        g->cells[2 * c + 1] = grid_sub_pack(n);
+        nleaves += (uint64_t)n[0] * (uint64_t)n[1] * (uint64_t)n[2];
+        g->subgrids += n[0] * n[1] * n[2] > 1;
+    }
+    return nleaves;
+}
+
+int grid_build_leaves(Grid *g, const Mesh *m, const int sub_res[3], float density, char *err,
+                      size_t errlen)
+{
+    double t0 = now_ms();
+    grid_leaves_free(g);
+    if (sub_res && (sub_res[0] <= 0 || sub_res[1] <= 0 || sub_res[2] <= 0)) sub_res = NULL;
+    if (!(density > 0.0f) || !isfinite(density)) density = GRID_SUB_DEFAULT_DENSITY;
+    g->cells = malloc(2 * (size_t)g->ncells * sizeof *g->cells);
+    if (!g->cells) goto oom;
+    uint64_t nleaves = leaves_layout(g, sub_res, density);
+    if (nleaves > GRID_MAX_LEAVES) {
+        grid_error(err, errlen, "grid: the sub-grids have %llu cells, more than the limit %u",
+                   (unsigned long long)nleaves, GRID_MAX_LEAVES);
+        grid_leaves_free(g);
+        return -1;
+    }
+    g->nleaves = (uint32_t)nleaves;
+    g->leaf_start = calloc((size_t)nleaves + 1, sizeof *g->leaf_start);
+    if (!g->leaf_start) goto oom;
+    uint64_t total = leaves_pass(g, m, g->leaf_start, NULL);
+    if (total > UINT32_MAX) {
+        grid_error(err, errlen,
+                   "grid: %llu triangle references in the sub-grids, more than 2^32-1; use "
+                   "coarser sub-grids",
+                   (unsigned long long)total);
+        grid_leaves_free(g);
+        return -1;
+    }
+    g->leaf_tris = malloc((total > 0 ? (size_t)total : 1) * sizeof *g->leaf_tris);
+    if (!g->leaf_tris) goto oom;
+    uint32_t sum = 0;
+    for (uint32_t l = 0; l < g->nleaves; l++) {
+        uint32_t k = g->leaf_start[l];
+        g->tris_per_leaf_max = k > g->tris_per_leaf_max ? k : g->tris_per_leaf_max;
+        g->leaf_start[l] = sum;
+        sum += k;
+    }
+    g->leaf_start[g->nleaves] = sum;
+    g->nleaf_refs = sum;
+    leaves_pass(g, m, g->leaf_start, g->leaf_tris);
+    memmove(g->leaf_start + 1, g->leaf_start, (size_t)g->nleaves * sizeof *g->leaf_start);
+    g->leaf_start[0] = 0;
+    g->leaves_ms = now_ms() - t0;
+    return 0;
+oom:
+    grid_error(err, errlen, "grid: out of memory for the sub-grids of %u cells", g->ncells);
+    grid_leaves_free(g);
+    return -1;
+}
+
+int grid_build_levels(Grid *g, const Mesh *m, const int res[3], float density, const int sub[3],
+                      float sub_density, char *err, size_t errlen)
+{
+    int one_level = sub && sub[0] == 1 && sub[1] == 1 && sub[2] == 1;
+    int rc;
+    if (one_level)
+        rc = grid_build(g, m, res, density, err, errlen);
+    else
+        rc = grid_build_tuned(g, m, res, density > 0.0f ? density : GRID_TOP_DEFAULT_DENSITY, 0.0f,
+                              GRID_AUTO_MAX_CELLS, err, errlen);
+    if (rc) return rc;
+    if (grid_build_leaves(g, m, sub, sub_density, err, errlen)) {
+        grid_free(g);
+        return -1;
+    }
+    g->build_ms += g->leaves_ms;
+    return 0;
+}
+
 void grid_free(Grid *g)
 {
     free(g->cell_start);
     free(g->cell_tris);
+    grid_leaves_free(g);
     memset(g, 0, sizeof *g);
 }

@@ -32,6 +32,10 @@ static void frame_camera(const Scene *s, VbCamera *c)
     }
 }
 
+/* The host's packed top cells (grid.h) are the kernels' VbGridCell array. */
+VBCL_STATIC_ASSERT(GRID_SUB_BITS == VBCL_GRID_SUB_BITS, grid_sub_bits);
+VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 2 * sizeof(uint32_t), grid_cell_words);
+
 static void frame_grid(const Grid *g, VbGrid *out)
 {
     memset(out, 0, sizeof *out);
@@ -211,11 +215,13 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
                            unsigned features, char *err, size_t errlen)
 {
     size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
-    if (nbytes_tris > dev->max_alloc || sizeof(uint32_t) * (size_t)g->nrefs > dev->max_alloc) {
+    if (nbytes_tris > dev->max_alloc || sizeof(uint32_t) * (size_t)g->nleaf_refs > dev->max_alloc ||
+        sizeof(uint32_t) * ((size_t)g->nleaves + 1) > dev->max_alloc) {
         snprintf(err, errlen,
-                 "%s: the scene (%u triangles, %u grid references) does not fit in "
-                 "one allocation on %s (%.0f MiB at most)",
-                 s->path, s->mesh.ntris, g->nrefs, dev->name, (double)dev->max_alloc / 1048576.0);
+                 "%s: the scene (%u triangles, %u grid references in %u leaves) does not fit "
+                 "in one allocation on %s (%.0f MiB at most)",
+                 s->path, s->mesh.ntris, g->nleaf_refs, g->nleaves, dev->name,
+                 (double)dev->max_alloc / 1048576.0);
         return 2;
     }
     VbTriangle *tris = pack_triangles(s);
@@ -233,10 +239,12 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
         CL_MEM_READ_ONLY);
     free(tris);
     free(normals);
-    b->cell_start =
-        clu_buffer(dev, g->cell_start, sizeof(uint32_t) * (g->ncells + 1u), CL_MEM_READ_ONLY);
-    b->cell_tris = clu_buffer(dev, g->cell_tris, sizeof(uint32_t) * g->nrefs, CL_MEM_READ_ONLY);
-    if (b->tris && b->normals && b->cell_start && b->cell_tris) return 0;
+    b->grid_cells = clu_buffer(dev, g->cells, sizeof(VbGridCell) * g->ncells, CL_MEM_READ_ONLY);
+    b->leaf_start =
+        clu_buffer(dev, g->leaf_start, sizeof(uint32_t) * (g->nleaves + 1u), CL_MEM_READ_ONLY);
+    b->leaf_tris =
+        clu_buffer(dev, g->leaf_tris, sizeof(uint32_t) * g->nleaf_refs, CL_MEM_READ_ONLY);
+    if (b->tris && b->normals && b->grid_cells && b->leaf_start && b->leaf_tris) return 0;
     snprintf(err, errlen, "%s: %s", dev->name, clu_error());
     return 1;
 }

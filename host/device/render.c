@@ -59,7 +59,9 @@ static int renderer_build(Renderer *r, const Scene *s, const char *extra_options
 {
     char gerr[256];
     const int *res = (s->grid_res[0] > 0) ? s->grid_res : NULL;
-    if (grid_build(&r->grid, &s->mesh, res, s->grid_density, gerr, sizeof gerr)) {
+    const int *sub = (s->subgrid_res[0] > 0) ? s->subgrid_res : NULL;
+    if (grid_build_levels(&r->grid, &s->mesh, res, s->grid_density, sub, s->subgrid_density, gerr,
+                          sizeof gerr)) {
         snprintf(err, errlen, "%s: grid: %s", s->path, gerr);
         return 2;
     }

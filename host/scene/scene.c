@@ -77,9 +77,11 @@ const char *scene_display_name(const char *path)
     return strcmp(path, "-") == 0 ? "<stdin>" : path;
 }
 
-int scene_parse_grid(const char *text, int res[3])
+/* Parses "auto", "N" or "NX,NY,NZ" (1..max_axis each, at most GRID_MAX_CELLS in all) from
+ * text up to end. Returns 0 and sets res (all 0 for auto), or -1. */
+static int parse_resolution(const char *text, const char *end, int max_axis, int res[3])
 {
-    if (strcmp(text, "auto") == 0) {
+    if ((size_t)(end - text) == 4 && strncmp(text, "auto", 4) == 0) {
         res[0] = res[1] = res[2] = 0;
         return 0;
     }
@@ -87,14 +89,14 @@ int scene_parse_grid(const char *text, int res[3])
     const char *p = text;
     int n = 0;
     while (n < 3) {
-        char *end;
+        char *stop;
         errno = 0;
-        v[n] = strtol(p, &end, 10);
-        if (end == p || errno || v[n] < 1 || v[n] > GRID_MAX_AXIS) return -1;
+        v[n] = strtol(p, &stop, 10);
+        if (stop == p || stop > end || errno || v[n] < 1 || v[n] > max_axis) return -1;
         n++;
-        if (*end == 0) break;
-        if (*end != ',') return -1;
-        p = end + 1;
+        if (stop == end) break;
+        if (*stop != ',') return -1;
+        p = stop + 1;
     }
     if (n == 1)
         v[1] = v[2] = v[0];
@@ -102,6 +104,23 @@ int scene_parse_grid(const char *text, int res[3])
         return -1;
     if ((uint64_t)v[0] * (uint64_t)v[1] * (uint64_t)v[2] > GRID_MAX_CELLS) return -1;
     for (int i = 0; i < 3; i++) res[i] = (int)v[i];
+    return 0;
+}
+
+int scene_parse_grid(const char *text, int res[3])
+{
+    return parse_resolution(text, text + strlen(text), GRID_MAX_AXIS, res);
+}
+
+int scene_parse_grid_levels(const char *text, int res[3], int sub[3])
+{
+    const char *colon = strchr(text, ':');
+    if (!colon) return scene_parse_grid(text, res);
+    int r[3];
+    if (parse_resolution(text, colon, GRID_MAX_AXIS, r) ||
+        parse_resolution(colon + 1, colon + 1 + strlen(colon + 1), GRID_SUB_MAX_AXIS, sub))
+        return -1;
+    memcpy(res, r, sizeof r);
     return 0;
 }
 
@@ -158,6 +177,39 @@ static int get_bands(Ctx *c, const cJSON *j, Scene *s)
     return json_get_int(c, j, "render", "bands", 1, DISP_MAX_BANDS, 8, 0, &s->bands);
 }
 
+/* render.KEY: "auto" (res all 0), a number N or [nx, ny, nz] of 1 .. max_axis cells each,
+ * at most GRID_MAX_CELLS in all. Absent: res untouched. Returns 0, or -1 after an error. */
+static int get_resolution(Ctx *c, const cJSON *j, const char *key, int max_axis, int res[3])
+{
+    char path[32];
+    snprintf(path, sizeof path, "render.%s", key);
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(j, key);
+    if (!g) return 0;
+    if (cJSON_IsString(g)) {
+        if (strcmp(g->valuestring, "auto") != 0)
+            return scene_fail(c, path, "expected \"auto\", a number or [nx, ny, nz]");
+        res[0] = res[1] = res[2] = 0;
+    } else if (cJSON_IsNumber(g)) {
+        int n;
+        if (json_get_int(c, j, "render", key, 1, max_axis, 0, 1, &n)) return -1;
+        res[0] = res[1] = res[2] = n;
+    } else {
+        float v[3];
+        if (json_read_vec(c, g, path, 3, 1, max_axis, v)) return -1;
+        for (int i = 0; i < 3; i++) {
+            if (v[i] != floorf(v[i])) return scene_fail(c, path, "expected whole numbers of cells");
+            res[i] = (int)v[i];
+        }
+    }
+    uint64_t cells = (uint64_t)res[0] * res[1] * res[2];
+    if (cells > GRID_MAX_CELLS)
+        return scene_fail(c, path,
+                          "%dx%dx%d is %llu cells, more than the limit of %u (2^27) in all: use "
+                          "\"auto\" or fewer cells",
+                          res[0], res[1], res[2], (unsigned long long)cells, GRID_MAX_CELLS);
+    return 0;
+}
+
 /* render.aa, render.aa_max_level, render.aa_floor: adaptive anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
@@ -169,13 +221,26 @@ static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {
-        "max_depth",     "grid",       "grid_density", "shadow_samples", "ambient",  "seed",
-        "fresnel",       "min_weight", "aa",           "aa_max_level",   "aa_floor", "bands",
-        "shadow_jitter", NULL};
+    static const char *const keys[] = {"max_depth",
+                                       "grid",
+                                       "grid_density",
+                                       "shadow_samples",
+                                       "ambient",
+                                       "seed",
+                                       "fresnel",
+                                       "min_weight",
+                                       "aa",
+                                       "aa_max_level",
+                                       "aa_floor",
+                                       "bands",
+                                       "shadow_jitter",
+                                       "subgrid",
+                                       "subgrid_density",
+                                       NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
-    s->grid_density = GRID_DEFAULT_DENSITY;
+    s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
+    s->subgrid_density = GRID_SUB_DEFAULT_DENSITY;
     s->shadow_samples = 16;
     memcpy(s->ambient, amb, sizeof amb);
     s->seed = 1;
@@ -192,8 +257,9 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
     if (json_get_int(c, j, "render", "max_depth", 1, 64, 6, 0, &s->max_depth) ||
-        json_get_float(c, j, "render", "grid_density", 0.01, 64, GRID_DEFAULT_DENSITY, 0,
-                       &s->grid_density) ||
+        json_get_float(c, j, "render", "grid_density", 0.01, 64, 0.0, 0, &s->grid_density) ||
+        json_get_float(c, j, "render", "subgrid_density", 0.01, 64, GRID_SUB_DEFAULT_DENSITY, 0,
+                       &s->subgrid_density) ||
         json_get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
         json_get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
         json_get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
@@ -217,33 +283,9 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         else
             return scene_fail(c, "render.fresnel", "expected \"exact\" or \"thesis\"");
     }
-    const cJSON *g = cJSON_GetObjectItemCaseSensitive(j, "grid");
-    if (g) {
-        if (cJSON_IsString(g)) {
-            if (strcmp(g->valuestring, "auto") != 0)
-                return scene_fail(c, "render.grid", "expected \"auto\", a number or [nx, ny, nz]");
-        } else if (cJSON_IsNumber(g)) {
-            int n;
-            if (json_get_int(c, j, "render", "grid", 1, GRID_MAX_AXIS, 0, 1, &n)) return -1;
-            s->grid_res[0] = s->grid_res[1] = s->grid_res[2] = n;
-        } else {
-            float v[3];
-            if (json_read_vec(c, g, "render.grid", 3, 1, GRID_MAX_AXIS, v)) return -1;
-            for (int i = 0; i < 3; i++) {
-                if (v[i] != floorf(v[i]))
-                    return scene_fail(c, "render.grid", "expected whole numbers of cells");
-                s->grid_res[i] = (int)v[i];
-            }
-        }
-        uint64_t cells = (uint64_t)s->grid_res[0] * s->grid_res[1] * s->grid_res[2];
-        if (cells > GRID_MAX_CELLS)
-            return scene_fail(
-                c, "render.grid",
-                "%dx%dx%d is %llu cells, more than the limit of %u (2^27) in all: use "
-                "\"auto\" or fewer cells",
-                s->grid_res[0], s->grid_res[1], s->grid_res[2], (unsigned long long)cells,
-                GRID_MAX_CELLS);
-    }
+    if (get_resolution(c, j, "grid", GRID_MAX_AXIS, s->grid_res) ||
+        get_resolution(c, j, "subgrid", GRID_SUB_MAX_AXIS, s->subgrid_res))
+        return -1;
     return 0;
 }
 

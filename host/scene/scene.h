@@ -64,8 +64,10 @@ typedef struct Scene {
     float fov; /* vertical, degrees */
     /* render */
     int max_depth;
-    int grid_res[3]; /* all 0: auto */
-    float grid_density;
+    int grid_res[3];    /* all 0: auto */
+    float grid_density; /* cells per triangle of `auto`; 0: the default (grid_build_levels) */
+    int subgrid_res[3]; /* the second level's resolution in every crowded cell; all 0: auto */
+    float subgrid_density;
     int shadow_samples; /* as given; the kernels use the nearest square */
     float ambient[3];
     unsigned seed;
@@ -138,5 +140,10 @@ void scene_medium_at(const Scene *s, vec3 p, VbMedium *m);
  * (1..GRID_MAX_AXIS each, at most GRID_MAX_CELLS in all).
  * Returns 0 and sets res (all 0 for auto), or -1. */
 int scene_parse_grid(const char *text, int res[3]);
+
+/* Parses both levels of a grid as written on the command line: TOP or TOP:SUB, each "auto",
+ * "N" or "NX,NY,NZ" (TOP as scene_parse_grid; SUB 1..GRID_SUB_MAX_AXIS each). Returns 0 and
+ * sets res, and sub when SUB is given (all 0 for auto), or -1 (res and sub untouched). */
+int scene_parse_grid_levels(const char *text, int res[3], int sub[3]);
 
 #endif
