@@ -31,21 +31,17 @@ VB_INLINE float3 ray_offset_origin(float3 p, float3 n, float scale)
     vb_max3(fmax(fabs(tri_vertex(tris, tri, 0).xyz),                                               \
                  fmax(fabs(tri_vertex(tris, tri, 1).xyz), fabs(tri_vertex(tris, tri, 2).xyz))))
 
-/* Per-ray constants of the watertight test: the axis permutation that makes the
- * largest direction component z, and the shear that maps the ray onto +z, folded into
- * three rows so that a vertex p maps to (dot(p, rx), dot(p, ry), dot(p, rz)). Each row
- * holds 1 (or Sz) on one axis, -S on the z axis and 0 elsewhere; the sums are written
- * out so that, with contraction off, every vertex maps identically in every triangle
- * that shares it (what watertightness needs), without run-time shuffles. */
+/* Per-ray constants of the watertight test (Woop, Benthin & Wald 2013): the axis
+ * permutation that makes the largest direction component z (kx, ky, kz, as a shuffle
+ * mask) and the shear that maps the ray onto +z. A vertex p maps to
+ * (q.x - sx q.z, q.y - sy q.z, sz q.z) with q = shuffle(p - org): the same few operations
+ * for every triangle that shares the vertex (contraction is off), which is what
+ * watertightness needs, and a third of the multiplications of a full 3x3 shear. */
 typedef struct RayShear {
-    float3 org;
-    float3 rx, ry, rz;
+    float4 org;
+    uint4 perm;
+    float sx, sy, sz;
 } RayShear;
-
-VB_INLINE float3 vb_axis(uint k)
-{
-    return (float3)(k == 0u ? 1.0f : 0.0f, k == 1u ? 1.0f : 0.0f, k == 2u ? 1.0f : 0.0f);
-}
 
 VB_INLINE float vb_comp(float3 v, uint k)
 {
@@ -65,21 +61,18 @@ VB_INLINE RayShear ray_shear_make(float3 org, float3 dir)
         kx = ky;
         ky = t;
     }
-    float sx = vb_comp(dir, kx) / dz, sy = vb_comp(dir, ky) / dz, sz = 1.0f / dz;
-    float3 ez = vb_axis(kz);
-    r.org = org;
-    r.rx = vb_axis(kx) - sx * ez;
-    r.ry = vb_axis(ky) - sy * ez;
-    r.rz = sz * ez;
+    r.sx = vb_comp(dir, kx) / dz;
+    r.sy = vb_comp(dir, ky) / dz;
+    r.sz = 1.0f / dz;
+    r.org = (float4)(org, 0.0f);
+    r.perm = (uint4)(kx, ky, kz, kz);
     return r;
 }
 
-VB_INLINE float3 ray_shear_apply(const RayShear *r, float3 p)
+VB_INLINE float3 ray_shear_apply(const RayShear *r, float4 p)
 {
-    float3 q = p - r->org;
-    return (float3)(q.x * r->rx.x + q.y * r->rx.y + q.z * r->rx.z,
-                    q.x * r->ry.x + q.y * r->ry.y + q.z * r->ry.z,
-                    q.x * r->rz.x + q.y * r->rz.y + q.z * r->rz.z);
+    float4 q = shuffle(p - r->org, r->perm);
+    return (float3)(q.x - r->sx * q.z, q.y - r->sy * q.z, r->sz * q.z);
 }
 
 /* Intersects the sheared ray with triangle (a, b, c). On a hit with 0 < t < tmax
@@ -88,9 +81,9 @@ VB_INLINE float3 ray_shear_apply(const RayShear *r, float3 p)
 VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
                             float *t_out, float *u_out, float *v_out)
 {
-    float3 A = ray_shear_apply(r, a4.xyz);
-    float3 B = ray_shear_apply(r, b4.xyz);
-    float3 C = ray_shear_apply(r, c4.xyz);
+    float3 A = ray_shear_apply(r, a4);
+    float3 B = ray_shear_apply(r, b4);
+    float3 C = ray_shear_apply(r, c4);
     float ax = A.x, ay = A.y, bx = B.x, by = B.y, cx = C.x, cy = C.y;
     float U = cx * by - cy * bx;
     float V = ax * cy - ay * cx;
