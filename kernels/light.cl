@@ -53,10 +53,14 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 o
 #endif
 }
 
-/* Counts of one work item's shadow feelers, summed by the caller. */
+/* Counts of one work item's shadow feelers, summed by the caller: traced; skipped, the
+ * light being below the surface's horizon; unneeded, the BRDF giving the direction
+ * nothing (no diffuse term, and outside the specular lobe: (N.H)^n < 1e-4), so that
+ * whether the light is visible there changes nothing. */
 typedef struct ShadowCount {
     uint traced;
     uint skipped;
+    uint unneeded;
 } ShadowCount;
 
 /* What shading a point under one light needs besides the point itself: the BRDF's
@@ -68,6 +72,10 @@ typedef struct LightShading {
     float spec_norm; /* normalises the Blinn-Phong lobe: (n + 8) / (8 pi) */
     float nh_min;    /* (N.H)^n < 1e-4 below this cosine: such samples skip the costly pow */
     float exponent;
+#endif
+    int diffuse; /* kd is not zero */
+#ifdef VBCL_HAS_SPECULAR
+    int specular; /* ks is not zero */
 #endif
     float3 origin; /* feelers start here, off the surface on the viewer's side */
     float3 to_c;   /* from the point to the light's centre */
@@ -121,6 +129,17 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                 sc->skipped++;
                 continue;
             }
+#ifdef VBCL_HAS_SPECULAR
+            float3 hv = normalize(w + sp->wo);
+            float nh = dot(sp->ns, hv);
+            int lobe = ls->specular && nh > ls->nh_min;
+#else
+            int lobe = 0;
+#endif
+            if (!ls->diffuse && !lobe) { /* the BRDF gives this direction nothing */
+                sc->unneeded++;
+                continue;
+            }
             /* distance to the near side of the light sphere along w */
             float b = dot(w, ls->to_c);
             float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
@@ -130,9 +149,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             if (vb_max3(vis) <= 0.0f) continue;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
-            float3 hv = normalize(w + sp->wo);
-            float nh = dot(sp->ns, hv);
-            if (nh > ls->nh_min) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
+            if (lobe) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
 #endif
         }
     }
@@ -163,8 +180,10 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     ls.d2 = dot(ls.to_c, ls.to_c);
     ls.d = sqrt(ls.d2);
     ls.kd = diffuse * (1.0f / VB_PI);
+    ls.diffuse = vb_max3(ls.kd) > 0.0f;
 #ifdef VBCL_HAS_SPECULAR
     ls.ks = vb_gload3(m->specular);
+    ls.specular = vb_max3(ls.ks) > 0.0f;
     ls.exponent = m->exponent;
     ls.spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
     ls.nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
@@ -189,15 +208,22 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
         sc->skipped++;
         return (float3)(0.0f);
     }
-    sc->traced++;
-    float3 vis = light_feeler(scn, sp, ls.origin, w, ls.d, tc);
-    if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
     float3 brdf = ls.kd;
 #ifdef VBCL_HAS_SPECULAR
     float3 hv = normalize(w + sp->wo);
     float nh = dot(sp->ns, hv);
-    if (nh > ls.nh_min) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
+    int lobe = ls.specular && nh > ls.nh_min;
+    if (lobe) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
+#else
+    int lobe = 0;
 #endif
+    if (!ls.diffuse && !lobe) { /* the BRDF gives this direction nothing */
+        sc->unneeded++;
+        return (float3)(0.0f);
+    }
+    sc->traced++;
+    float3 vis = light_feeler(scn, sp, ls.origin, w, ls.d, tc);
+    if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
     return radiance * brdf * vis * (cos_n / ls.d2);
 }
 

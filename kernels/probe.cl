@@ -70,7 +70,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.scale = 0.0f;
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
-    ShadowCount sc2 = {0, 0};
+    ShadowCount sc2 = {0, 0, 0};
     float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
     vstore4((float4)(col, (float)sc2.traced), i, radiance);
 }

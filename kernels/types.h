@@ -60,7 +60,8 @@
     X(INTERFACES,      11, interfaces,      ray_tree, "interfaces")       /* energy splits */      \
     X(ENERGY_ERRORS,   12, energy_errors,   ray_tree, "energy_errors")    /* |R+T-1| > 1e-5 */     \
     X(SPLITS,          13, splits,          ray_tree, "splits")           /* white -> bands */     \
-    X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */
+    X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */     \
+    X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */
 /* clang-format on */
 #define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
 enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };

@@ -493,8 +493,8 @@ static void test_cli_stats_json(void)
     if ((l = strstr(out, "\nrays        primary ")))
         got += sscanf(l, "\nrays primary %llu, refinement %llu, shadow %llu", &primary, &refine,
                       &shadow) == 3;
-    if ((l = strstr(out, "skipped: light behind the surface), total ")))
-        got += sscanf(l, "skipped: light behind the surface), total %llu", &total) == 1;
+    if ((l = strstr(out, "unneeded: no BRDF response), total ")))
+        got += sscanf(l, "unneeded: no BRDF response), total %llu", &total) == 1;
     if ((l = strstr(out, " objects, "))) got += sscanf(l, " objects, %u triangles", &tris) == 1;
     if ((l = strstr(out, " cells ("))) {
         while (l > out && l[-1] != ' ') l--;
