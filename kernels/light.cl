@@ -82,6 +82,46 @@ typedef struct LightShading {
     float d2, d;   /* its squared length and length */
 } LightShading;
 
+/* The terms of the BRDF at sp for material m (its diffuse colour `diffuse`, pattern
+ * included) under a light whose centre is c. */
+VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 diffuse,
+                                          const ShadePoint *sp, float3 c)
+{
+    LightShading ls;
+    ls.to_c = c - sp->p;
+    ls.d2 = dot(ls.to_c, ls.to_c);
+    ls.d = sqrt(ls.d2);
+    ls.kd = diffuse * (1.0f / VB_PI);
+    ls.diffuse = vb_max3(ls.kd) > 0.0f;
+#ifdef VBCL_HAS_SPECULAR
+    ls.ks = vb_gload3(m->specular);
+    ls.specular = vb_max3(ls.ks) > 0.0f;
+    ls.exponent = m->exponent;
+    ls.spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
+    ls.nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
+#else
+    (void)m;
+#endif
+    ls.origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
+    return ls;
+}
+
+/* Whether the BRDF gives direction w anything: a diffuse term, or w inside the specular
+ * lobe ((N.H)^n >= 1e-4), with *nh = N.H. A feeler the BRDF gives nothing is not traced:
+ * the light's visibility there cannot change the image. */
+VB_INLINE int light_brdf_responds(const LightShading *ls, const ShadePoint *sp, float3 w, float *nh)
+{
+#ifdef VBCL_HAS_SPECULAR
+    *nh = dot(sp->ns, normalize(w + sp->wo));
+    return ls->diffuse || (ls->specular && *nh > ls->nh_min);
+#else
+    (void)sp;
+    (void)w;
+    *nh = 0.0f;
+    return ls->diffuse;
+#endif
+}
+
 #ifdef VBCL_HAS_AREA_LIGHTS
 /* The direction of the feeler in stratum (i, j) of the cap of half-angle theta_max around
  * wc (frame tx, ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle, at a
@@ -129,14 +169,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                 sc->skipped++;
                 continue;
             }
-#ifdef VBCL_HAS_SPECULAR
-            float3 hv = normalize(w + sp->wo);
-            float nh = dot(sp->ns, hv);
-            int lobe = ls->specular && nh > ls->nh_min;
-#else
-            int lobe = 0;
-#endif
-            if (!ls->diffuse && !lobe) { /* the BRDF gives this direction nothing */
+            float nh;
+            if (!light_brdf_responds(ls, sp, w, &nh)) {
                 sc->unneeded++;
                 continue;
             }
@@ -149,7 +183,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             if (vb_max3(vis) <= 0.0f) continue;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
-            if (lobe) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
+            if (ls->specular && nh > ls->nh_min) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
 #endif
         }
     }
@@ -172,25 +206,9 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
                                    __global const VbMaterial *m, float3 diffuse,
                                    const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
 {
-    float3 c = vb_gload3(light->centre);
     float3 radiance = vb_gload3(light->radiance);
     float r = light->radius;
-    LightShading ls;
-    ls.to_c = c - sp->p;
-    ls.d2 = dot(ls.to_c, ls.to_c);
-    ls.d = sqrt(ls.d2);
-    ls.kd = diffuse * (1.0f / VB_PI);
-    ls.diffuse = vb_max3(ls.kd) > 0.0f;
-#ifdef VBCL_HAS_SPECULAR
-    ls.ks = vb_gload3(m->specular);
-    ls.specular = vb_max3(ls.ks) > 0.0f;
-    ls.exponent = m->exponent;
-    ls.spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
-    ls.nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
-#else
-    (void)m;
-#endif
-    ls.origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
+    LightShading ls = light_shading_make(m, diffuse, sp, vb_gload3(light->centre));
 #ifdef VBCL_HAS_AREA_LIGHTS
     if (r > 0.0f) {
         if (ls.d <= r * 1.0001f) { /* inside the light: lit from every direction, no shadow */
@@ -208,19 +226,15 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
         sc->skipped++;
         return (float3)(0.0f);
     }
-    float3 brdf = ls.kd;
-#ifdef VBCL_HAS_SPECULAR
-    float3 hv = normalize(w + sp->wo);
-    float nh = dot(sp->ns, hv);
-    int lobe = ls.specular && nh > ls.nh_min;
-    if (lobe) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
-#else
-    int lobe = 0;
-#endif
-    if (!ls.diffuse && !lobe) { /* the BRDF gives this direction nothing */
+    float nh;
+    if (!light_brdf_responds(&ls, sp, w, &nh)) {
         sc->unneeded++;
         return (float3)(0.0f);
     }
+    float3 brdf = ls.kd;
+#ifdef VBCL_HAS_SPECULAR
+    if (ls.specular && nh > ls.nh_min) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
+#endif
     sc->traced++;
     float3 vis = light_feeler(scn, sp, ls.origin, w, ls.d, tc);
     if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
