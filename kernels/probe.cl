@@ -256,9 +256,9 @@ VB_INLINE void probe_store_ray(__global VbRay *out, float3 org, float3 dir, floa
 #ifdef VBCL_HAS_AREA_LIGHTS
 /* The feelers light_reflect_area traces toward a light of radius r > 0 whose centre is to_c
  * away (d2, d: its squared length and length), in its order; returns how many. */
-VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, float3 origin,
-                                float3 to_c, float d2, float d, float r, uint key, uint sample,
-                                __global VbRay *out)
+VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, const LightShading *ls,
+                                float3 origin, float3 to_c, float d2, float d, float r, uint key,
+                                uint sample, __global VbRay *out)
 {
     uint strata = sc->f->shadow_strata;
     int jitter = !(sc->f->flags & VBCL_FRAME_FIXED_FEELERS);
@@ -271,7 +271,9 @@ VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, float3
     for (uint i = 0; i < strata; i++)
         for (uint j = 0; j < strata; j++) {
             float3 w = light_cap_direction(i, j, strata, key, jitter, one_minus_cos, tx, ty, wc);
+            float nh;
             if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
+            if (!light_brdf_responds(ls, sp, w, &nh)) continue; /* unneeded: not traced */
             float b = dot(w, to_c);
             float disc = fmax(0.0f, b * b - (d2 - r * r));
             probe_store_ray(out + k++, origin, w, b - sqrt(disc), sample);
@@ -294,10 +296,14 @@ VB_INLINE int probe_point_feelers(const DevScene *sc, const ShadePoint *sp, uint
         float d2 = dot(to_c, to_c);
         float d = sqrt(d2);
         float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
+        __global const VbMaterial *m = sc->materials + sp->material;
+        LightShading ls =
+            light_shading_make(m, vb_gload3(m->diffuse) * scene_pattern_colour(sc, m, sp->p), sp,
+                               vb_gload3(light->centre));
 #ifdef VBCL_HAS_AREA_LIGHTS
         if (light->radius > 0.0f) {
             if (d > light->radius * 1.0001f)
-                k += probe_cap_feelers(sc, sp, origin, to_c, d2, d, light->radius, key, sample,
+                k += probe_cap_feelers(sc, sp, &ls, origin, to_c, d2, d, light->radius, key, sample,
                                        out + k);
             continue;
         }
@@ -305,7 +311,9 @@ VB_INLINE int probe_point_feelers(const DevScene *sc, const ShadePoint *sp, uint
         (void)key;
 #endif
         float3 w = to_c / d;
+        float nh;
         if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
+        if (!light_brdf_responds(&ls, sp, w, &nh)) continue; /* unneeded: not traced */
         probe_store_ray(out + k++, origin, w, d, sample);
     }
     return k;
