@@ -257,9 +257,10 @@ VB_INLINE void probe_store_ray(__global VbRay *out, float3 org, float3 dir, floa
 /* The feelers light_reflect_area traces toward a light of radius r > 0 whose centre is to_c
  * away (d2, d: its squared length and length), in its order; returns how many. */
 VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, const LightShading *ls,
-                                float3 origin, float3 to_c, float d2, float d, float r, uint key,
-                                uint sample, __global VbRay *out)
+                                float r, uint key, uint sample, __global VbRay *out)
 {
+    float3 origin = ls->origin, to_c = ls->to_c;
+    float d2 = ls->d2, d = ls->d;
     uint strata = sc->f->shadow_strata;
     int jitter = !(sc->f->flags & VBCL_FRAME_FIXED_FEELERS);
     float3 wc = to_c / d;
@@ -292,29 +293,24 @@ VB_INLINE int probe_point_feelers(const DevScene *sc, const ShadePoint *sp, uint
     for (uint l = 0; l < sc->f->nlights; l++) {
         __global const VbLight *light = sc->lights + l;
         uint key = vb_hash(sp->key * 0x27d4eb2fu + l);
-        float3 to_c = vb_gload3(light->centre) - sp->p;
-        float d2 = dot(to_c, to_c);
-        float d = sqrt(d2);
-        float3 origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
         __global const VbMaterial *m = sc->materials + sp->material;
         LightShading ls =
             light_shading_make(m, vb_gload3(m->diffuse) * scene_pattern_colour(sc, m, sp->p), sp,
                                vb_gload3(light->centre));
 #ifdef VBCL_HAS_AREA_LIGHTS
         if (light->radius > 0.0f) {
-            if (d > light->radius * 1.0001f)
-                k += probe_cap_feelers(sc, sp, &ls, origin, to_c, d2, d, light->radius, key, sample,
-                                       out + k);
+            if (ls.d > light->radius * 1.0001f)
+                k += probe_cap_feelers(sc, sp, &ls, light->radius, key, sample, out + k);
             continue;
         }
 #else
         (void)key;
 #endif
-        float3 w = to_c / d;
+        float3 w = ls.to_c / ls.d;
         float nh;
         if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
         if (!light_brdf_responds(&ls, sp, w, &nh)) continue; /* unneeded: not traced */
-        probe_store_ray(out + k++, origin, w, d, sample);
+        probe_store_ray(out + k++, ls.origin, w, ls.d, sample);
     }
     return k;
 }
