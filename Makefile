@@ -44,7 +44,7 @@ MAIN_OBJ := $(BUILD)/host/main.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench bench-grid stress oclgrind fuzz FORCE test-drivers
+.PHONY: all run test deps format format-check clean bench bench-grid gallery stress oclgrind fuzz FORCE test-drivers
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh
@@ -116,15 +116,25 @@ run: vbcl
 # Runs every test (kernels on the default OpenCL device). Sanitizer builds run the tests
 # against their own instrumented vbcl.
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0)
-# Then every benchmark part on tiny images (scripts/bench.py --quick), so that `make bench`
-# cannot rot; not in sanitizer builds, whose timings mean nothing.
+# Then the gallery script on two figures at 16x16 and every benchmark part on tiny images
+# (scripts/bench.py --quick), so that `make gallery` and `make bench` cannot rot; not in
+# sanitizer builds, whose timings mean nothing.
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
+	$(Q)scripts/gallery.py --vbcl $(BUILD)/vbcl --size 16 --scenes a1,a6 --out $(BUILD)/gallery-quick \
+	  > $(BUILD)/gallery-quick.log 2>&1 && echo "gallery --size 16: ran (A.1, A.6)" \
+	  || { tail -30 $(BUILD)/gallery-quick.log; echo "gallery --size 16 FAILED"; exit 1; }
 	$(Q)scripts/bench.py --quick --vbcl $(BUILD)/vbcl --out $(BUILD)/bench-quick > $(BUILD)/bench-quick.log 2>&1 \
 	  && echo "bench --quick: every part ran ($(BUILD)/bench-quick/bench.md)" \
 	  || { tail -30 $(BUILD)/bench-quick.log; echo "bench --quick FAILED"; exit 1; }
 endif
+
+# The thesis's appendix figures A.1 ... A.8 at their own settings (400x400), one at a time:
+# PNG files in docs/images/thesis/ and the README's gallery table with each render's measured
+# time, samples per pixel and rays (scripts/gallery.py; about 4 minutes on 2 cores).
+gallery: vbcl
+	scripts/gallery.py --vbcl ./vbcl --out docs/images/thesis --readme README.md
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
 # figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
