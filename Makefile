@@ -138,7 +138,8 @@ gallery: vbcl
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
 # figure A.4, throughput across grid sizes, run time against error for anti-aliasing and
-# band counts, kernel build time, rays per second against Embree and per OpenCL device. CSV,
+# band counts, kernel build time, rays per second against Embree and per OpenCL device, and
+# figure A.4 by acceleration structure (about 18 minutes on 2 cores). CSV,
 # markdown and PNG in bench-out/. BENCH_FLAGS passes options, e.g. BENCH_FLAGS="--parts grid".
 BENCH_FLAGS ?=
 # Embree, for the part "embree", is installed here (install-deps.sh --bench); where it cannot

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""bench.py — `make bench`: the thesis's own measurements and ours, in six parts.
+"""bench.py — `make bench`: the thesis's own measurements and ours, in seven parts.
 
   1. thesis   the table of thesis section 4.1.5 on the figure A.4 scene: anti-aliasing
               threshold x ray-tree depth x dispersion -> rendering, anti-aliasing and
@@ -13,9 +13,11 @@
   5. embree   Mrays/s per ray kind against Embree 3 on the same triangles and rays
               (build/vbcl-bench-rays, tests/bench/bench_rays.c; vbcl alone without Embree);
   6. drivers  Mrays/s by ray kind on every OpenCL device vbcl sees (PoCL; Intel's CPU
-              runtime too after `. "$(scripts/intel-ocl.sh)"`), to pick a driver.
+              runtime too after `. "$(scripts/intel-ocl.sh)"`), to pick a driver;
+  7. accel    figure A.4 at 400x400 by acceleration structure: the thesis's grid 20 with
+              sub-grids, as its one level, auto and auto with one level.
 
-usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build,embree,drivers]
+usage: scripts/bench.py [--quick] [--parts thesis,grid,error,build,embree,drivers,accel]
                         [--vbcl ./vbcl] [--out bench-out] [--size N] [--repeats N]
                         [--bench-rays PATH]
 
@@ -342,6 +344,49 @@ def part_error(a, out):
     return aa_text + "\n" + text
 
 
+# Part 7: figure A.4 by acceleration structure (--grid), at the thesis's 400x400: the
+# thesis's grid 20 with sub-grids (the default), as the thesis's one level (20:1), auto and
+# auto without sub-grids; each unrefined (threshold 1.0, the table's first row) and the
+# two-level ones also at the figure's own threshold 0.1.
+ACCEL_GRIDS = [("20", "two levels (default)"), ("20:1", "one level, as the thesis"),
+               ("auto", "two levels"), ("auto:1", "one level")]
+
+
+def part_accel(a, out):
+    size = a.size or (12 if a.quick else 400)
+    quick = ["--shadow-samples", "1", "--aa-max-level", "2"] if a.quick else []
+    rows = []
+    for thr in (1.0, 0.1):
+        for g, label in ACCEL_GRIDS:
+            if thr != 1.0 and g.endswith(":1"):
+                continue
+            opts = ["--width", str(size), "--height", str(size), "--aa", str(thr), "--grid", g,
+                    "-o", os.path.join(a.tmp, "accel.exr")] + quick
+            run_stats(a.vbcl, A4, ["--width", "8", "--height", "8", "--grid", g, "--aa",
+                                   str(thr), "-o", os.path.join(a.tmp, "warm.exr")])
+            st = median_stats(a.vbcl, A4, opts, a.repeats)
+            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+            rows.append({"threshold": thr, "grid": g, "structure": label, "cells": st["grid"],
+                         "total_s": f"{st['total_ms'] / 1000:.2f}",
+                         "render_s": f"{st['render_ms'] / 1000:.2f}",
+                         "rays": int(st["rays_total"]),
+                         "mrays_s": f"{st['rays_total'] / (st['render_ms'] * 1e3):.2f}",
+                         "kernel_s": f"{kern / 1000:.2f}"})
+            print(f"accel: {rows[-1]}", flush=True)
+    for r in rows:  # each against the default (grid 20, two levels) at its threshold
+        base = next(b for b in rows if b["threshold"] == r["threshold"] and b["grid"] == "20")
+        r["vs_default"] = f"{float(r['total_s']) / float(base['total_s']):.2f}"
+    note = (f"`{A4}` at {size}x{size}, median of {a.repeats} (one run where it takes over "
+            f"{LONG_RUN_MS / 1000:g} s). total_s: the whole run; render_s: the render's wall "
+            "time; mrays_s: every ray over render_s; kernel_s: the tracing kernels' device "
+            "time (every pass); vs_default: total_s against grid 20 with sub-grids at the "
+            "same threshold.")
+    return write_table(out, "accel", rows,
+                       ["threshold", "grid", "structure", "cells", "total_s", "render_s", "rays",
+                        "mrays_s", "kernel_s", "vs_default"],
+                       "Figure A.4 by acceleration structure", note)
+
+
 def part_build(a, out):
     scenes = [("opaque (quickstart)", "scenes/quickstart.json"),
               ("glass and textures (glass_bombed_sphere)", "scenes/glass_bombed_sphere.json"),
@@ -521,7 +566,7 @@ def machine(vbcl):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes: every part runs (CI)")
-    ap.add_argument("--parts", default="thesis,grid,error,build,embree,drivers")
+    ap.add_argument("--parts", default="thesis,grid,error,build,embree,drivers,accel")
     ap.add_argument("--vbcl", default="./vbcl")
     ap.add_argument("--out", default="bench-out")
     ap.add_argument("--size", type=int, default=0, help="image size of parts 1 and 2")
@@ -534,6 +579,7 @@ def main():
     a.repeats = a.repeats or (1 if a.quick else 3)
     os.makedirs(a.out, exist_ok=True)
     parts = {"thesis": part_thesis, "grid": part_grid, "error": part_error, "build": part_build,
+             "accel": part_accel,
              "embree": part_embree, "drivers": part_drivers}
     chosen = [p.strip() for p in a.parts.split(",") if p.strip()]
     for p in chosen:
