@@ -220,15 +220,17 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
     return c.hit;
 }
 
-/* Whether any triangle of one leaf lies on the ray before tmax; adds the tests to *tests. */
+/* Whether any triangle of one leaf lies on the ray before tmax, those whose tag has a bit
+ * of `skip` not counted; adds the tests to *tests. */
 VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
                             __global const uint *leaf_start, __global const uint *leaf_tris,
-                            uint leaf, uint *tests)
+                            uint leaf, uint skip, uint *tests)
 {
     uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
     int blocked = 0;
     for (uint k = begin; k < end && !blocked; k++) {
         int tri = (int)leaf_tris[k];
+        if (skip != 0u && (tri_tag(tris, tri) & skip) != 0u) continue;
         float t, u, v;
         (*tests)++;
         blocked = tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
@@ -238,11 +240,12 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow
- * feeler: the first occluder ends the walk). */
+ * feeler: the first occluder ends the walk); triangles whose tag has a bit of `skip`
+ * (VBCL_TAG_TEXTURE, or 0) are not occluders. */
 VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
                              __global const VbGridCell *cells, __global const uint *leaf_start,
                              __global const uint *leaf_tris, float3 org, float3 dir, float tmax,
-                             TraceCount *count)
+                             uint skip, TraceCount *count)
 {
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return 0;
@@ -255,7 +258,7 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
         VbGridCell gc = cells[grid_cell_index(g, w.cell)];
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
         if (gc.res == VBCL_GRID_LIST) {
-            blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, gc.first, &tests);
+            blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, gc.first, skip, &tests);
         } else {
             int3 n = grid_cell_res(gc);
             GridWalk s;
@@ -263,7 +266,7 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
             do {
                 steps++;
                 uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
-                blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, leaf, &tests);
+                blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, leaf, skip, &tests);
             } while (!blocked && grid_walk_step(n, &s));
         }
         t_in = cell_exit;

@@ -49,7 +49,16 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 o
     return medium_shadow_transmittance(sc, origin, w, t, sp->medium, sp->band, tc);
 #else
     (void)sp;
-    return scene_trace_any(sc, origin, w, t, tc) ? (float3)(0.0f) : (float3)(1.0f);
+#ifdef VBCL_HAS_TEXTURES
+    /* Without transparency every host and element is opaque: a texture surface that a
+     * feeler from outside meets before its host's surface lies outside the host, where the
+     * texture does not exist, and one inside a host lies behind the host's opaque surface.
+     * So texture triangles never stop a feeler here. */
+    const uint skip = VBCL_TAG_TEXTURE;
+#else
+    const uint skip = 0u;
+#endif
+    return scene_trace_any(sc, origin, w, t, skip, tc) ? (float3)(0.0f) : (float3)(1.0f);
 #endif
 }
 

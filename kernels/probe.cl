@@ -186,7 +186,7 @@ __kernel void probe_trace_any(SCENE_KERNEL_ARGS __global const VbRay *rays, int 
     DevScene sc = DEV_SCENE;
     VbRay r = rays[i];
     TraceCount tc = {0, 0};
-    blocked[i] = (uchar)scene_trace_any(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+    blocked[i] = (uchar)scene_trace_any(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, 0u, &tc);
 }
 
 /* The shading point at the first interface of primary ray i, as light_sample_shading makes

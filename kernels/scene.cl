@@ -53,12 +53,13 @@ VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, 
                               org, dir, tmax, tc);
 }
 
-/* Whether anything lies on (org, dir) before tmax. */
-VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float tmax,
+/* Whether anything lies on (org, dir) before tmax, triangles whose tag has a bit of `skip`
+ * (VBCL_TAG_TEXTURE, or 0) left out. */
+VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float tmax, uint skip,
                               TraceCount *tc)
 {
     return grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_tris,
-                          org, dir, tmax, tc);
+                          org, dir, tmax, skip, tc);
 }
 
 /* Material of an opaque-scene triangle: its object's own material. */

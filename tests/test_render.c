@@ -181,8 +181,59 @@ static void test_render_quickstart_soft_shadow(void)
     for (int i = 0; i < 3; i++) free(img[i]);
 }
 
+/* An opaque box carved by a texture of its own material, the texture reaching beyond the
+ * box, renders as the plain box: texture surfaces exist only inside their host, so the
+ * parts outside cast no shadow (kernels without transparency trace feelers as any-hit and
+ * must leave texture triangles out: light.cl, light_feeler). */
+static void test_render_texture_outside_host_casts_no_shadow(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const char head[] =
+        "{\"image\": {\"width\": 48, \"height\": 48},"
+        " \"camera\": {\"eye\": [2.5, 2.2, 3.2], \"look_at\": [0, 0.4, 0], \"fov\": 40},"
+        " \"render\": {\"grid\": 8, \"shadow_samples\": 4},"
+        " \"lights\": [{\"centre\": [3, 5, 4], \"radius\": 0.5, \"flux\": 2000}],"
+        " \"materials\": {\"wood\": {\"diffuse\": [0.8, 0.6, 0.4]}},"
+        " \"objects\": [{\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"wood\"},"
+        " {\"shape\": \"box\", \"size\": [1.2, 0.8, 1.2], \"material\": \"wood\","
+        "  \"transform\": {\"translate\": [0, 0.4, 0]}";
+    static const char tex[] =
+        ", \"texture\": {\"generate\": \"deform --count 3 --spacing 3 --taper none --length 8 "
+        "--segments 12 --rings 1\", \"material\": \"wood\", \"block\": [-6, -6, 1, 6, 6, 7]}";
+    char text[2048], out[2][512], err[512];
+    float *img[2] = {NULL, NULL};
+    int w = 0, h = 0;
+    for (int i = 0; i < 2; i++) {
+        snprintf(text, sizeof text, "%s%s}]}", head, i ? tex : "");
+        const char *scene = tu_write_file(i ? "carved.json" : "plain.json", text);
+        snprintf(out[i], sizeof out[i], "%s/carved_%d.exr", tu_tmpdir(), i);
+        if (!scene || render(scene, out[i], NULL)) return;
+        if (image_read(out[i], &w, &h, &img[i], err, sizeof err)) {
+            CHECK(0, "%s", err);
+            free(img[0]);
+            return;
+        }
+    }
+    double sum = 0.0, worst = 0.0;
+    for (int i = 0; i < 4 * w * h; i++) {
+        double d = fabs((double)img[0][i] - img[1][i]);
+        sum += d;
+        worst = fmax(worst, d);
+    }
+    double mean = sum / (4.0 * w * h);
+    fprintf(stderr, "    carved box against the plain one: mean |difference| %.3g, worst %.3g\n",
+            mean, worst);
+    CHECK(mean < 1e-4, "the texture outside its host casts no shadow: mean difference %g", mean);
+    free(img[0]);
+    free(img[1]);
+}
+
 void suite_render(void)
 {
+    RUN_TEST(test_render_texture_outside_host_casts_no_shadow);
     RUN_TEST(test_render_quickstart_soft_shadow);
     RUN_TEST(test_render_penumbra_matches_geometry);
     RUN_TEST(test_render_quickstart_reference);
