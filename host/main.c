@@ -429,6 +429,11 @@ static int load_frame(const Options *o, const char *text, int frame, Scene *s)
         diag_print(prog, "%s", err);
         return 2;
     }
+    static int warned; /* once, not once per frame of an animation */
+    if (s->warning[0] && !o->quiet && !warned && mpi_rank <= 0) {
+        diag_print(prog, "warning: %s", s->warning);
+        warned = 1;
+    }
     int rc = apply_options(o, s);
     if (rc) scene_free(s);
     return rc;

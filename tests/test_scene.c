@@ -586,11 +586,58 @@ static void test_scene_animation(void)
 #undef ANIM_BAD
 }
 
+/* A texture whose faces lie in its host's faces (texgen deform's tubes are exactly as long
+ * as its block, and the default block fits the box) loads with a warning naming the
+ * texture and the plane; a block with a margin, or a host without faces there, loads
+ * without one. */
+static void test_scene_texture_faces_warning(void)
+{
+    char old[512] = "";
+    const char *prev = getenv("VBCL_CACHE_DIR");
+    if (prev) snprintf(old, sizeof old, "%s", prev);
+    setenv("VBCL_CACHE_DIR", "off", 1);
+    static const char texgen[] =
+        "deform --count 1 --spacing 4 --taper none --length 8 --segments 8 --rings 1";
+    struct {
+        const char *shape, *block;
+        int warns;
+    } cases[] = {
+        {"box", "", 1},
+        {"box", ", \"block\": [-5, -5, 0.5, 5, 5, 7.5]", 0},
+        {"sphere", "", 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char json[1024];
+        snprintf(json, sizeof json,
+                 MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"%s\", \"material\": \"m\", "
+                                "\"texture\": {\"generate\": \"%s\", \"material\": \"m\"%s}}]}",
+                 cases[i].shape, texgen, cases[i].block);
+        Scene s;
+        char err[1024] = "";
+        int rc = load_text(json, &s, err, sizeof err);
+        CHECK(rc == 0, "case %zu loads: %s", i, err);
+        if (rc != 0) continue;
+        if (cases[i].warns)
+            CHECK(strstr(s.warning, "scene.json: objects[0].texture: ") &&
+                      strstr(s.warning, "lie in a face of the object (its plane z = ") &&
+                      strstr(s.warning, "speckle"),
+                  "case %zu: the warning names the texture and the plane: \"%s\"", i, s.warning);
+        else
+            CHECK(s.warning[0] == 0, "case %zu: no warning, got \"%s\"", i, s.warning);
+        scene_free(&s);
+    }
+    if (old[0])
+        setenv("VBCL_CACHE_DIR", old, 1);
+    else
+        unsetenv("VBCL_CACHE_DIR");
+}
+
 void suite_scene(void)
 {
     RUN_TEST(test_scene_animation);
     RUN_TEST(test_scene_examples_load);
     RUN_TEST(test_scene_texture_generate_inline);
+    RUN_TEST(test_scene_texture_faces_warning);
     RUN_TEST(test_scene_minimal_defaults);
     RUN_TEST(test_scene_all_shapes_and_transform);
     RUN_TEST(test_scene_bad_syntax);

@@ -95,6 +95,8 @@ typedef struct Scene {
     Mesh mesh;         /* all objects and textures, world space */
     uint32_t *tri_tag; /* per triangle: object index | VBCL_TAG_TEXTURE (texture triangles) |
                           VBCL_TAG_OPAQUE (an object that is not a host) */
+    char warning[512]; /* the first thing the scene loads but will not render as meant
+                        * ("FILE: json.path: what and why"), or "" */
 } Scene;
 
 /* Whether objects[i].texture.generate runs the texture generators (texgen_bomb,

@@ -79,6 +79,7 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
         vec3 lo, hi;
         mesh_bounds(&m, &lo, &hi);
         if (scene_load_texture(c, t, q, s, lo, hi, &tex, &ob->tex_material)) goto done;
+        scene_texture_check_faces(c, q, &m, &tex, s);
         ob->tex_slot = s->ntextured++;
     }
     ob->is_host = t != NULL || s->materials[ob->material].gpu.k_global > 0.0f;

@@ -33,6 +33,11 @@ int scene_load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, ve
 /* objects[]: every object and its texture into the scene mesh, then the check that hosts
  * do not overlap (scene_objects.c). */
 int scene_load_objects(Ctx *c, const cJSON *j, Scene *s);
+/* Notes in s->warning (the first only) when triangles of the texture tex lie in faces of
+ * its host (both in the object's own space) that are planes of the host's bounding box: a
+ * ray meets both at one distance and such a face renders as speckle. p: the JSON path of
+ * the texture. */
+void scene_texture_check_faces(Ctx *c, const char *p, const Mesh *host, const Mesh *tex, Scene *s);
 
 /* Applies root.animation for frame `frame` (-1: checks the tracks, changes nothing) and
  * returns the frame count in *frames (scene_animation.c). */

@@ -244,3 +244,43 @@ int scene_load_texture(Ctx *c, const cJSON *t, const char *p, const Scene *s, ve
     mesh_transform(tex, &map);
     return 0;
 }
+
+static float v3_comp(vec3 v, int k)
+{
+    return k == 0 ? v.x : (k == 1 ? v.y : v.z);
+}
+
+/* Triangles of m whose three vertices lie within eps of the plane (axis k) = w. */
+static uint32_t tris_in_plane(const Mesh *m, int k, float w, float eps)
+{
+    uint32_t n = 0;
+    for (uint32_t t = 0; t < m->ntris; t++) {
+        int in = 1;
+        for (int j = 0; j < 3 && in; j++)
+            in = fabsf(v3_comp(m->verts[m->tris[3 * t + j]], k) - w) <= eps;
+        n += (uint32_t)in;
+    }
+    return n;
+}
+
+void scene_texture_check_faces(Ctx *c, const char *p, const Mesh *host, const Mesh *tex, Scene *s)
+{
+    if (s->warning[0] || host->ntris == 0 || tex->ntris == 0) return;
+    vec3 lo, hi;
+    mesh_bounds(host, &lo, &hi);
+    float size = fmaxf(hi.x - lo.x, fmaxf(hi.y - lo.y, hi.z - lo.z));
+    for (int k = 0; k < 6; k++) {
+        float w = v3_comp(k < 3 ? lo : hi, k % 3);
+        float eps = 1e-5f * fmaxf(size, fabsf(w)); /* about 100 ulps: a float's mapping */
+        if (tris_in_plane(host, k % 3, w, eps) == 0) continue;
+        uint32_t n = tris_in_plane(tex, k % 3, w, eps);
+        if (n == 0) continue;
+        diag_format(s->warning, sizeof s->warning,
+                    "%s: %s: %u triangles of the texture lie in a face of the object (its plane "
+                    "%c = %s, in the object's own coordinates): a ray meets both surfaces at one "
+                    "distance, and that face renders as speckle; give \"block\" a margin "
+                    "(docs/scene-format.md)",
+                    c->file, p, n, "xyz"[k % 3], diag_num(w));
+        return;
+    }
+}
