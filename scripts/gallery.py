@@ -11,7 +11,9 @@ half size), OUT/gallery.json (the numbers) and
 OUT/gallery.md (the table). With --readme, the table replaces the part of that file between
 the lines "<!-- gallery begin -->" and "<!-- gallery end -->". --size N renders at NxN
 instead of the scenes' own size (a quick check that the script runs; not for the README).
-Every figure is rendered alone, one after another, so the times are the machine's whole.
+Every figure is rendered alone, one after another, so the times are the machine's whole;
+each is first rendered with one shadow feeler per point so that its time does not include
+building its program.
 """
 import argparse
 import json
@@ -57,11 +59,11 @@ def cpu_name():
     return platform.processor() or platform.machine()
 
 
-def render(vbcl, scene, out_png, size):
+def render(vbcl, scene, out_png, size, extra=()):
     """Renders one figure; returns its --stats-json document (an animation's: the frames)."""
     fd, stats = tempfile.mkstemp(prefix="vbcl-gallery-", suffix=".json")
     os.close(fd)
-    opts = ["-q", "--stats-json", stats, "-o", out_png]
+    opts = ["-q", "--stats-json", stats, "-o", out_png] + list(extra)
     if size:
         opts += ["--width", str(size), "--height", str(size)]
     try:
@@ -156,6 +158,12 @@ def main():
         with open(scene) as f:
             animated = "animation" in json.load(f)
         print(f"gallery: {figure} {scene}", flush=True)
+        # warm: build the scene's program and let PoCL compile its kernels (at their first
+        # launch, for the work-group sizes of this image size) with one feeler per point, so
+        # that the time measured is a render's, not a first build's
+        with tempfile.TemporaryDirectory() as tmp:
+            render(a.vbcl, scene, os.path.join(tmp, "warm_##.png"), a.size,
+                   ["--shadow-samples", "1"])
         if animated:  # the frames into a scratch folder, the mosaic into OUT
             with tempfile.TemporaryDirectory() as tmp:
                 st = summarise(render(a.vbcl, scene, os.path.join(tmp, "f_##.png"), a.size))
