@@ -216,9 +216,14 @@ def part_thesis(a, out):
                        note)
 
 
+def kernel_ms(st):
+    """Device time of the tracing kernels: intersect, shading, ray trees, dispersion."""
+    return st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+
+
 def grid_row(label, g, levels, st):
     """One row of the grid part from the median stats of one (scene, grid, levels)."""
-    kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+    kern = kernel_ms(st)
     secondary = st["reflected"] + st["transmitted"]
     return {
         "scene": label, "triangles": int(st["triangles"]), "grid": g, "levels": levels,
@@ -365,7 +370,7 @@ def part_accel(a, out):
             run_stats(a.vbcl, A4, ["--width", "8", "--height", "8", "--grid", g, "--aa",
                                    str(thr), "-o", os.path.join(a.tmp, "warm.exr")])
             st = median_stats(a.vbcl, A4, opts, a.repeats)
-            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+            kern = kernel_ms(st)
             rows.append({"threshold": thr, "grid": g, "structure": label, "cells": st["grid"],
                          "total_s": f"{st['total_ms'] / 1000:.2f}",
                          "render_s": f"{st['render_ms'] / 1000:.2f}",
@@ -460,7 +465,7 @@ def part_drivers(a, out):
         for index, name in devices:
             rs = sorted(runs[index], key=lambda r: r["total_ms"])
             st = rs[len(rs) // 2]
-            kern = st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
+            kern = kernel_ms(st)
             secondary = st["reflected"] + st["transmitted"]
             rows.append({
                 "device": f"{index}: {name}", "scene": label,
