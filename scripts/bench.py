@@ -221,21 +221,30 @@ def kernel_ms(st):
     return st["intersect_ms"] + st["shading_ms"] + st["tree_ms"] + st["dispersion_ms"]
 
 
-def grid_row(label, g, levels, st):
-    """One row of the grid part from the median stats of one (scene, grid, levels)."""
+def throughput(st):
+    """Mrays/s of the stages every throughput table shows: primary (camera rays over the
+    intersect kernel), secondary (reflected and transmitted rays over the ray-tree kernel),
+    all (every ray over the tracing kernels), and those kernels' time."""
     kern = kernel_ms(st)
     secondary = st["reflected"] + st["transmitted"]
     return {
-        "scene": label, "triangles": int(st["triangles"]), "grid": g, "levels": levels,
-        "cells": st["grid"],
         "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
-        "shading_mrays_s": (f"{(st['rays_primary'] + st['rays_shadow']) / ((st['shading_ms'] + st['tree_ms']) * 1e3):.2f}"
-                            if st["shading_ms"] > 0 else ""),
         "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
                               if st["tree_ms"] > 0 else ""),
         "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
         "kernel_ms": f"{kern:.1f}",
     }
+
+
+def grid_row(label, g, levels, st):
+    """One row of the grid part from the median stats of one (scene, grid, levels)."""
+    shading = st["shading_ms"] + st["tree_ms"]
+    return dict(throughput(st), **{
+        "scene": label, "triangles": int(st["triangles"]), "grid": g, "levels": levels,
+        "cells": st["grid"],
+        "shading_mrays_s": (f"{(st['rays_primary'] + st['rays_shadow']) / (shading * 1e3):.2f}"
+                            if st["shading_ms"] > 0 else ""),
+    })
 
 
 def part_grid(a, out):
@@ -465,18 +474,11 @@ def part_drivers(a, out):
         for index, name in devices:
             rs = sorted(runs[index], key=lambda r: r["total_ms"])
             st = rs[len(rs) // 2]
-            kern = kernel_ms(st)
-            secondary = st["reflected"] + st["transmitted"]
-            rows.append({
+            rows.append(dict(throughput(st), **{
                 "device": f"{index}: {name}", "scene": label,
-                "primary_mrays_s": f"{st['rays_primary'] / (st['intersect_ms'] * 1e3):.2f}",
                 "shadow_mrays_s": (f"{st['rays_shadow'] / (st['shading_ms'] * 1e3):.2f}"
                                    if st["shading_ms"] > 0 else ""),
-                "secondary_mrays_s": (f"{secondary / (st['tree_ms'] * 1e3):.3f}"
-                                      if st["tree_ms"] > 0 else ""),
-                "all_mrays_s": f"{st['rays_total'] / (kern * 1e3):.2f}",
-                "kernel_ms": f"{kern:.1f}",
-            })
+            }))
             print(f"drivers: {rows[-1]}", flush=True)
     note = (f"{size}x{size}, median of {a.repeats} (the devices interleaved), every device "
             "`vbcl --list-devices` shows (Intel's CPU runtime too after `. \"$(scripts/intel-ocl.sh)\"`). primary: camera "

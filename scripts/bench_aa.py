@@ -28,6 +28,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vbcl_stats import read_stats_json  # noqa: E402  (bench.py imports it from here too)
+
 
 def need_modules():
     try:
@@ -95,19 +98,6 @@ def reseeded(scene):
     with open(path, "w") as f:
         json.dump(data, f)
     return path
-
-
-def read_stats_json(vbcl, scene, opts, env=None):
-    """Runs vbcl -q --stats-json on scene; returns the document (fields: docs/stats.md)."""
-    fd, path = tempfile.mkstemp(prefix="vbcl-stats-", suffix=".json")
-    os.close(fd)
-    try:
-        subprocess.run([vbcl, scene, "-q", "--stats-json", path] + opts, check=True,
-                       capture_output=True, text=True, env=env)
-        with open(path) as f:
-            return json.load(f)
-    finally:
-        os.remove(path)
 
 
 def render(vbcl, scene, size, extra, opts, out, full=False):

@@ -24,6 +24,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vbcl_stats import read_stats_json  # noqa: E402
+
 # The appendix, in the thesis's order: scene file, figure, caption (the thesis's own
 # words, shortened where it repeats itself), and what the thesis says of its time.
 FIGURES = [
@@ -61,17 +64,10 @@ def cpu_name():
 
 def render(vbcl, scene, out_png, size, extra=()):
     """Renders one figure; returns its --stats-json document (an animation's: the frames)."""
-    fd, stats = tempfile.mkstemp(prefix="vbcl-gallery-", suffix=".json")
-    os.close(fd)
-    opts = ["-q", "--stats-json", stats, "-o", out_png] + list(extra)
+    opts = ["-o", out_png] + list(extra)
     if size:
         opts += ["--width", str(size), "--height", str(size)]
-    try:
-        subprocess.run([vbcl, scene] + opts, check=True)
-        with open(stats) as f:
-            return json.load(f)
-    finally:
-        os.remove(stats)
+    return read_stats_json(vbcl, scene, opts)
 
 
 def summarise(doc):
