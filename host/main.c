@@ -62,6 +62,8 @@ static const char usage_text[] =
     "                           (0..1; 0 off)\n"
     "      --aa-max-level L     deepest refinement, 2^L x 2^L subpixels per pixel (1..4)\n"
     "      --aa-floor F         contrast of dark pairs: a+b counts as at least F (0..2)\n"
+    "      --aa-level-gain G    the threshold of a subpixel at level L is THRESHOLD*G^L\n"
+    "                           (1..4; default 2; 1: the thesis's, alike at every level)\n"
     "      --bands N|thesis     wavelength bands of a dispersive refraction (1..64), or the\n"
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
@@ -90,7 +92,7 @@ typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
-    double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor;
+    double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
     int list_devices, stats, quiet;
 } Options;
@@ -158,6 +160,7 @@ static const OptionSpec option_specs[] = {
     {"--aa", NULL, OPT_DOUBLE, offsetof(Options, aa), 0, 1},
     {"--aa-max-level", NULL, OPT_INT, offsetof(Options, aa_max_level), 1, VBCL_AA_MAX_LEVEL},
     {"--aa-floor", NULL, OPT_DOUBLE, offsetof(Options, aa_floor), 0, 2},
+    {"--aa-level-gain", NULL, OPT_DOUBLE, offsetof(Options, aa_level_gain), 1, 4},
     {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
     {"--aa-map", NULL, OPT_STRING, offsetof(Options, aa_map), 0, 0},
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
@@ -251,6 +254,7 @@ static int parse_args(int argc, char **argv, Options *o)
     memset(o, 0, sizeof *o);
     o->width = o->height = o->shadow_samples = o->depth = -1;
     o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
+    o->aa_level_gain = -1;
     o->aa_max_level = o->ssaa = o->bands = -1;
     o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
@@ -362,6 +366,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->min_weight >= 0) s->min_weight = (float)o->min_weight;
     if (o->aa >= 0) s->aa_threshold = (float)o->aa;
     if (o->aa_floor >= 0) s->aa_floor = (float)o->aa_floor;
+    if (o->aa_level_gain > 0) s->aa_level_gain = (float)o->aa_level_gain;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
     if (o->bands >= 0) {
         s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;

@@ -91,9 +91,10 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
     }
     if (!(s->aa_threshold > 0.0f)) return;
     fprintf(f,
-            "anti-alias  adaptive quadtree, threshold %g, floor %g, max level %d, %d rounds; "
-            "pixels refined to level",
-            (double)s->aa_threshold, (double)s->aa_floor, s->aa_max_level, st->aa_rounds);
+            "anti-alias  adaptive quadtree, threshold %g (x %g per level), floor %g, max level %d, "
+            "%d rounds; pixels refined to level",
+            (double)s->aa_threshold, (double)s->aa_level_gain, (double)s->aa_floor, s->aa_max_level,
+            st->aa_rounds);
     for (int l = 1; l <= s->aa_max_level; l++)
         fprintf(f, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
                 l < s->aa_max_level ? "," : "\n");
@@ -283,6 +284,7 @@ static void json_samples(cJSON *root, const Scene *s, const RenderStats *st, int
     num(o, "ssaa", s->ssaa > 1 ? s->ssaa : 1, ok);
     fnum(o, "threshold", adaptive ? s->aa_threshold : 0.0f, ok);
     fnum(o, "floor", adaptive ? s->aa_floor : 0.0f, ok);
+    fnum(o, "level_gain", adaptive ? s->aa_level_gain : 0.0f, ok);
     num(o, "max_level", adaptive ? s->aa_max_level : 0, ok);
     num(o, "rounds", st->aa_rounds, ok);
     cJSON *a = arr(o, "refined_per_level", ok);

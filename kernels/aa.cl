@@ -47,12 +47,16 @@ VB_INLINE float4 aa_leaf_at(__constant const VbAaPass *aa, __global const float 
  * fails the contrast test against an adjacent leaf at its level or deeper: the ring of
  * cells around it is walked one adjacent leaf at a time (leaves are aligned squares, so
  * the next leaf along a row starts at the next multiple of the current one's size). An
- * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2). */
+ * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2).
+ * The threshold at level lv is threshold * level_gain^lv: with a gain of 1 the thesis's
+ * (every level alike); with 2, an edge's share of its pixel's error, which halves with
+ * each level (2^L leaves of 4^-L of the pixel along it), is what is held to the threshold. */
 VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float *film,
                             __global const int *slots, __global const float *tree, int X0, int Y0,
                             int s, int lv, float3 a)
 {
     int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE;
+    float threshold = aa->threshold * pown(aa->level_gain, lv);
     for (int side = 0; side < 4; side++) {
         int row = side < 2; /* sides 0, 1: the rows above and below, corners included */
         int fixed = row ? (side == 0 ? Y0 - 1 : Y0 + s) : (side == 2 ? X0 - 1 : X0 + s);
@@ -62,7 +66,7 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
             float4 c = row ? aa_leaf_at(aa, film, slots, tree, t, fixed)
                            : aa_leaf_at(aa, film, slots, tree, fixed, t);
             int lc = (int)c.w, sc = AA_TREE_SIDE >> lc;
-            if (lc >= lv && aa_contrast_fails(a, aa_display(aa, c.xyz), aa->threshold, aa->floor))
+            if (lc >= lv && aa_contrast_fails(a, aa_display(aa, c.xyz), threshold, aa->floor))
                 return 1;
             t = (t / sc + 1) * sc;
         }

@@ -202,7 +202,8 @@ typedef struct VbAaPass {
     unsigned int first;   /* batch: its first entry in the list of marked nodes (or pixels) */
     unsigned int entries; /* batch: entries in it */
     int round;            /* adaptive: the round (0, 1, ...) of this contrast pass or batch */
-    unsigned int pad[2];
+    float level_gain;     /* a leaf at level L fails at threshold * level_gain^L */
+    unsigned int pad[1];
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */
@@ -274,7 +275,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
     X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
-    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(sizeof(VbSplit))    \
+    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
 /* clang-format on */
@@ -322,6 +323,7 @@ VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 48, aapass_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, floor) == 24, aapass_floor);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 28, aapass_first);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, level_gain) == 40, aapass_level_gain);
 
 /* The counter list's indices: distinct (their bits' sum equals their union), clear of the
  * reserved index 0 and below the by-depth counters. */

@@ -228,7 +228,7 @@ static void test_aa_options(void)
     }
     AaRender plain, one, cli, key;
     if (aa_render("opt_plain", "", 0, &plain) || aa_render("opt_ssaa1", "--ssaa 1", 0, &one) ||
-        aa_render("opt_cli", "--aa 0.1 --aa-max-level 3", 1, &cli))
+        aa_render("opt_cli", "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5", 1, &cli))
         return;
     CHECK(rmse(&plain, &one) == 0.0, "--ssaa 1 differs from the plain render: %g",
           rmse(&plain, &one));
@@ -237,7 +237,8 @@ static void test_aa_options(void)
     snprintf(out, sizeof out, "%s/aa_key.exr", tu_tmpdir());
     snprintf(cmd, sizeof cmd,
              "sed 's/\"ambient\": \\[1, 1, 1\\]/\"ambient\": [1, 1, 1], \"aa\": 0.1, "
-             "\"aa_max_level\": 3/' %s > %s/aa_key.json && %s %s/aa_key.json -q -o %s",
+             "\"aa_max_level\": 3, \"aa_level_gain\": 1.5/' %s > %s/aa_key.json && "
+             "%s %s/aa_key.json -q -o %s",
              AA_SCENE, tu_tmpdir(), tu_vbcl, tu_tmpdir(), out);
     int rc = tu_run(cmd, log, sizeof log);
     CHECK(rc == 0, "%s: exit %d: %s", cmd, rc, log);
@@ -253,7 +254,8 @@ static void test_aa_options(void)
                          "--aa 0.1 --ssaa 4",
                          "--aa-map m.png",
                          "--aa 0.1 --aa-map m.bmp",
-                         "--aa 0.1 --aa-floor 3"};
+                         "--aa 0.1 --aa-floor 3",
+                         "--aa 0.1 --aa-level-gain 0.5"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(cmd, sizeof cmd, "%s %s -q -o %s/never.png %s", tu_vbcl, AA_SCENE, tu_tmpdir(),
                  bad[i]);
@@ -352,6 +354,7 @@ typedef struct TwoPixelCase {
     unsigned odd[4], nodd;
     unsigned want[12], nwant;
     float floor; /* the contrast's floor on a + b (0: the thesis's plain ratio) */
+    float gain;  /* the threshold's growth per level (1: the thesis's) */
 } TwoPixelCase;
 
 static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, unsigned nodd,
@@ -379,6 +382,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
     memset(&pass, 0, sizeof pass);
     pass.threshold = 0.1f;
     pass.floor = tc->floor;
+    pass.level_gain = tc->gain;
     pass.contrast_scale = 1.0f;
     pass.max_level = VBCL_AA_MAX_LEVEL;
     pass.width = 2;
@@ -428,7 +432,18 @@ static void test_aa_neighbour_rule_across_levels(void)
     const TwoPixelCase cases[] = {
         /* pixel 1 finer and brighter everywhere: only pixel 0's two leaves along the
          * border split; pixel 1's leaves see a coarser neighbour and wait */
-        {"finer neighbour", 1, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {P0(1, 1, 0), P0(1, 1, 1)}, 2, 0.0f},
+        {"finer neighbour",
+         1,
+         2,
+         0.5f,
+         1.0f,
+         1.0f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1)},
+         2,
+         0.0f,
+         1.0f},
         /* one bright level-2 leaf of pixel 1 at the bottom of the border: pixel 0's
          * lower-right leaf splits (pixel 1's other border leaves equal it), its
          * upper-right one does not; inside pixel 1 the bright leaf and its three
@@ -443,7 +458,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          1,
          {P0(1, 1, 1), P1(2, 0, 3), P1(2, 0, 2), P1(2, 1, 2), P1(2, 1, 3)},
          5,
-         0.0f},
+         0.0f,
+         1.0f},
         /* a bright leaf higher up, (0, 1) (cells y 4..7): pixel 0's upper-right leaf
          * (y 0..7) meets it along the border, the lower-right one (y 8..15) only through
          * its corner cell (16, 7): both split */
@@ -458,7 +474,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 0), P0(1, 1, 1), P1(2, 0, 1), P1(2, 0, 0), P1(2, 1, 0), P1(2, 1, 1), P1(2, 1, 2),
           P1(2, 0, 2)},
          8,
-         0.0f},
+         0.0f,
+         1.0f},
         /* equal levels: both sides of the border split */
         {"tie",
          1,
@@ -470,7 +487,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          0,
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
          4,
-         0.0f},
+         0.0f,
+         1.0f},
         /* a dark pair: relative contrast 0.33 splits both sides; with a floor of 0.5 on
          * a + b the difference 0.01 is under 0.1 * 0.5 and nothing splits */
         {"dark pair",
@@ -483,10 +501,40 @@ static void test_aa_neighbour_rule_across_levels(void)
          0,
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
          4,
-         0.0f},
-        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f},
+         0.0f,
+         1.0f},
+        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f, 1.0f},
+        /* the threshold grows by the gain per level: contrast 1/3 fails 0.1 * 2 at level
+         * 1 (the tie above, now with gain 2: both sides split) but not 0.1 * 2^2 at level
+         * 2, where with the thesis's gain 1 all eight border leaves split */
+        {"gain 2, level 1",
+         1,
+         1,
+         0.5f,
+         1.0f,
+         1.0f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
+         4,
+         0.0f,
+         2.0f},
+        {"gain 2, level 2", 2, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {0}, 0, 0.0f, 2.0f},
+        {"gain 1, level 2",
+         2,
+         2,
+         0.5f,
+         1.0f,
+         1.0f,
+         {0},
+         0,
+         {P0(2, 3, 0), P0(2, 3, 1), P0(2, 3, 2), P0(2, 3, 3), P1(2, 0, 0), P1(2, 0, 1), P1(2, 0, 2),
+          P1(2, 0, 3)},
+         8,
+         0.0f,
+         1.0f},
         /* below the threshold nothing splits */
-        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f},
+        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f, 1.0f},
     };
     const int fresh[2] = {-1, 0}, stale[2] = {-1, -1};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {

@@ -278,6 +278,7 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     memset(pass, 0, sizeof *pass);
     pass->threshold = s->aa_threshold;
     pass->floor = s->aa_floor;
+    pass->level_gain = s->aa_level_gain;
     pass->contrast_scale = exp2f(s->exposure);
     pass->max_level = s->aa_max_level;
     pass->width = s->width;

@@ -210,33 +210,26 @@ static int get_resolution(Ctx *c, const cJSON *j, const char *key, int max_axis,
     return 0;
 }
 
-/* render.aa, render.aa_max_level, render.aa_floor: adaptive anti-aliasing. */
+/* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain: adaptive
+ * anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
     return json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
            json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
                         &s->aa_max_level) ||
-           json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor);
+           json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor) ||
+           json_get_float(c, j, "render", "aa_level_gain", 1, 4, SCENE_AA_LEVEL_GAIN, 0,
+                          &s->aa_level_gain);
 }
 
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {"max_depth",
-                                       "grid",
-                                       "grid_density",
-                                       "shadow_samples",
-                                       "ambient",
-                                       "seed",
-                                       "fresnel",
-                                       "min_weight",
-                                       "aa",
-                                       "aa_max_level",
-                                       "aa_floor",
-                                       "bands",
-                                       "shadow_jitter",
-                                       "subgrid",
-                                       "subgrid_density",
-                                       NULL};
+    static const char *const keys[] = {
+        "max_depth", "grid",          "grid_density", "shadow_samples",
+        "ambient",   "seed",          "fresnel",      "min_weight",
+        "aa",        "aa_max_level",  "aa_floor",     "aa_level_gain",
+        "bands",     "shadow_jitter", "subgrid",      "subgrid_density",
+        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
@@ -249,6 +242,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->aa_threshold = 0.0f;
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
     s->aa_floor = SCENE_AA_FLOOR;
+    s->aa_level_gain = SCENE_AA_LEVEL_GAIN;
     s->ssaa = 1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
