@@ -69,6 +69,8 @@ static const char usage_text[] =
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's deepest refinement level as a heat map\n"
     "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
+    "      --aa-samples-map FILE  write each pixel's number of samples as a heat map on the\n"
+    "                           same colours (dark 1, blue 4, green 16, yellow 64, red 256)\n"
     "      --device INDEX|NAME|all|LIST  OpenCL device (also VBCL_DEVICE; default: device 0);\n"
     "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
     "                           tiles among several (refinement runs on the first)\n"
@@ -89,7 +91,7 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid, *fresnel, *aa_map, *stats_json;
+    const char *scene, *output, *device, *grid, *fresnel, *aa_map, *aa_samples_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
@@ -163,6 +165,7 @@ static const OptionSpec option_specs[] = {
     {"--aa-level-gain", NULL, OPT_DOUBLE, offsetof(Options, aa_level_gain), 1, 4},
     {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
     {"--aa-map", NULL, OPT_STRING, offsetof(Options, aa_map), 0, 0},
+    {"--aa-samples-map", NULL, OPT_STRING, offsetof(Options, aa_samples_map), 0, 0},
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
     {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
     {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
@@ -334,8 +337,9 @@ static char *output_path(const Options *o, const Scene *s, int frame)
     return out;
 }
 
-/* Writes each pixel's refinement level as a heat map (aa_level_colour). */
-static int write_aa_map(const char *path, const Scene *s, const int *levels, char *err,
+/* Writes each pixel's refinement level (aa_level_colour) or, with samples set, its number
+ * of samples (aa_samples_colour) as a heat map. */
+static int write_aa_map(const char *path, const Scene *s, const int *values, int samples, char *err,
                         size_t errlen)
 {
     size_t npix = (size_t)s->width * (size_t)s->height;
@@ -345,7 +349,10 @@ static int write_aa_map(const char *path, const Scene *s, const int *levels, cha
         return -1;
     }
     for (size_t i = 0; i < npix; i++) {
-        aa_level_colour(levels[i], map + 4 * i);
+        if (samples)
+            aa_samples_colour(values[i], map + 4 * i);
+        else
+            aa_level_colour(values[i], map + 4 * i);
         map[4 * i + 3] = 1.0f;
     }
     int rc = image_write(path, s->width, s->height, map, 0.0f, err, errlen);
@@ -377,8 +384,9 @@ static int apply_options(const Options *o, Scene *s)
         if (o->aa > 0) return usage_error("%s", "--aa and --ssaa exclude each other");
         s->aa_threshold = 0.0f; /* --ssaa overrides the scene's render.aa */
     }
-    if (o->aa_map && !(s->aa_threshold > 0.0f))
-        return usage_error("%s", "--aa-map needs adaptive anti-aliasing (--aa or render.aa)");
+    if ((o->aa_map || o->aa_samples_map) && !(s->aa_threshold > 0.0f))
+        return usage_error("%s needs adaptive anti-aliasing (--aa or render.aa)",
+                           o->aa_map ? "--aa-map" : "--aa-samples-map");
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
     if (o->grid && scene_parse_grid_levels(o->grid, s->grid_res, s->subgrid_res))
@@ -494,13 +502,14 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
     int rc = 0, nwork = 0, max = ndev + (d ? d->size - 1 : 0) * CLU_MAX_DEVICES;
     char *out = output_path(o, &s, frame);
     char *map = !o->aa_map ? NULL : frame_path(o->aa_map, frame);
+    char *smap = !o->aa_samples_map ? NULL : frame_path(o->aa_samples_map, frame);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
     DeviceWork *work = calloc((size_t)max, sizeof *work);
     Frame fr;
     memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (!out || (o->aa_map && !map) || !rgba || !work) {
+    if (!out || (o->aa_map && !map) || (o->aa_samples_map && !smap) || !rgba || !work) {
         fprintf(stderr, "%s: out of memory for a %dx%d image\n", prog, s.width, s.height);
         rc = 1;
         dist_abort(d, 1); /* with other ranks: they wait for tiles */
@@ -510,7 +519,10 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
     if (rc) goto done;
     double tw = clu_now_ms();
     if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err) ||
-        (map && frame_levels(&fr) && write_aa_map(map, &s, frame_levels(&fr), err, sizeof err))) {
+        (map && frame_levels(&fr) &&
+         write_aa_map(map, &s, frame_levels(&fr), 0, err, sizeof err)) ||
+        (smap && frame_leaves(&fr) &&
+         write_aa_map(smap, &s, frame_leaves(&fr), 1, err, sizeof err))) {
         diag_print(prog, "%s", err);
         rc = 1;
         goto done;
@@ -524,6 +536,7 @@ done:
     free(work);
     free(out);
     free(map);
+    free(smap);
     scene_free(&s);
     return rc;
 }
@@ -582,16 +595,20 @@ static int check_output(const char *path)
     return check_output_dir(path);
 }
 
-/* Every output of frames first..last (or of the still image, frame -1): the image and
- * the --aa-map, checked before anything renders. */
+/* Every output of frames first..last (or of the still image, frame -1): the image, the
+ * --aa-map and the --aa-samples-map, checked before anything renders. */
 static int check_outputs(const Options *o, const Scene *s, int first, int last)
 {
     for (int f = first; f <= last; f++) {
         char *out = output_path(o, s, f), *map = o->aa_map ? frame_path(o->aa_map, f) : NULL;
-        int rc = (!out || (o->aa_map && !map)) ? 1 : check_output(out);
+        char *smap = o->aa_samples_map ? frame_path(o->aa_samples_map, f) : NULL;
+        int rc =
+            (!out || (o->aa_map && !map) || (o->aa_samples_map && !smap)) ? 1 : check_output(out);
         if (!rc && map) rc = check_output(map);
+        if (!rc && smap) rc = check_output(smap);
         free(out);
         free(map);
+        free(smap);
         if (rc) return rc;
         if (f < 0) break;
     }

@@ -21,20 +21,55 @@ typedef struct AaRender {
     int w, h;
     float *px;
     int *levels;         /* NULL without --aa */
+    int *leaves;         /* samples per pixel from --aa-samples-map; NULL without --aa */
     double samples_mean; /* from --stats */
     unsigned samples_max;
 } AaRender;
 
-/* Renders the test scene with extra options (to EXR, with --aa-map when map is set).
- * Returns 0, or -1 after a failed check. */
+/* Reads a heat map (EXR) of w x h into values: each pixel the n in lo..hi whose colour
+ * (colour(n)) is nearest, which must be within 1e-6. Returns 0 or -1. */
+static int aa_read_map(const char *path, int w, int h, int lo, int hi,
+                       void (*colour)(int, float[3]), int *values)
+{
+    char err[512];
+    int mw, mh;
+    float *m;
+    if (image_read(path, &mw, &mh, &m, err, sizeof err)) {
+        CHECK(0, "%s", err);
+        return -1;
+    }
+    CHECK(mw == w && mh == h, "map %dx%d, image %dx%d", mw, mh, w, h);
+    for (int i = 0; i < mw * mh && mw == w && mh == h; i++) {
+        double best = 1e30;
+        for (int n = lo; n <= hi; n++) {
+            float c[3];
+            colour(n, c);
+            double d = 0;
+            for (int k = 0; k < 3; k++) d += (m[4 * i + k] - c[k]) * (m[4 * i + k] - c[k]);
+            if (d < best) {
+                best = d;
+                values[i] = n;
+            }
+        }
+        CHECK(best < 1e-12, "%s: pixel %d is no palette colour", path, i);
+    }
+    free(m);
+    return 0;
+}
+
+/* Renders the test scene with extra options (to EXR; with map set, also --aa-map and
+ * --aa-samples-map, decoded into levels and leaves). Returns 0, or -1 after a failed
+ * check. */
 static int aa_render(const char *name, const char *extra, int map, AaRender *out)
 {
-    char img[512], mpath[512], cmd[2048], log[16384], err[512];
+    char img[512], mpath[512], spath[512], cmd[2048], log[16384], err[512];
     memset(out, 0, sizeof *out);
     snprintf(img, sizeof img, "%s/aa_%s.exr", tu_tmpdir(), name);
     snprintf(mpath, sizeof mpath, "%s/aa_%s_map.exr", tu_tmpdir(), name);
-    snprintf(cmd, sizeof cmd, "%s %s -q --stats -o %s %s %s%s", tu_vbcl, AA_SCENE, img, extra,
-             map ? "--aa-map " : "", map ? mpath : "");
+    snprintf(spath, sizeof spath, "%s/aa_%s_samples.exr", tu_tmpdir(), name);
+    snprintf(cmd, sizeof cmd, "%s %s -q --stats -o %s %s %s%s %s%s", tu_vbcl, AA_SCENE, img, extra,
+             map ? "--aa-map " : "", map ? mpath : "", map ? "--aa-samples-map " : "",
+             map ? spath : "");
     int rc = tu_run(cmd, log, sizeof log);
     CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
     if (rc) return -1;
@@ -47,37 +82,42 @@ static int aa_render(const char *name, const char *extra, int map, AaRender *out
         return -1;
     }
     if (!map) return 0;
-    int mw, mh;
-    float *m;
-    if (image_read(mpath, &mw, &mh, &m, err, sizeof err)) {
-        CHECK(0, "%s", err);
-        return -1;
+    size_t npix = (size_t)out->w * (size_t)out->h;
+    out->levels = malloc(sizeof(int) * npix);
+    out->leaves = malloc(sizeof(int) * npix);
+    if (!out->levels || !out->leaves) return -1;
+    return aa_read_map(mpath, out->w, out->h, 0, VBCL_AA_MAX_LEVEL, aa_level_colour, out->levels) ||
+                   aa_read_map(spath, out->w, out->h, 1, VBCL_AA_CELLS, aa_samples_colour,
+                               out->leaves)
+               ? -1
+               : 0;
+}
+
+/* The two maps of an adaptive render agree with each other and with --stats: a pixel at
+ * level 0 has one sample, one at level L at least 1 + 3L (a split per level) and at most
+ * 4^L; the largest count is the samples line's max, the mean its mean (printed to 0.01). */
+static void aa_check_maps(const AaRender *r, const char *what)
+{
+    int bad = 0, max = 0;
+    double sum = 0;
+    for (int i = 0; i < r->w * r->h; i++) {
+        int l = r->levels[i], n = r->leaves[i];
+        bad += l == 0 ? n != 1 : (n < 1 + 3 * l || n > 1 << (2 * l));
+        max = n > max ? n : max;
+        sum += n;
     }
-    CHECK(mw == out->w && mh == out->h, "map %dx%d, image %dx%d", mw, mh, out->w, out->h);
-    out->levels = malloc(sizeof(int) * (size_t)mw * (size_t)mh);
-    for (int i = 0; i < mw * mh && out->levels; i++) {
-        /* the nearest colour of the palette */
-        double best = 1e30;
-        for (int l = 0; l <= VBCL_AA_MAX_LEVEL; l++) {
-            float c[3];
-            aa_level_colour(l, c);
-            double d = 0;
-            for (int k = 0; k < 3; k++) d += (m[4 * i + k] - c[k]) * (m[4 * i + k] - c[k]);
-            if (d < best) {
-                best = d;
-                out->levels[i] = l;
-            }
-        }
-        CHECK(best < 1e-6, "map pixel %d is no palette colour", i);
-    }
-    free(m);
-    return 0;
+    double mean = sum / (double)(r->w * r->h);
+    CHECK(bad == 0 && (unsigned)max == r->samples_max && fabs(mean - r->samples_mean) <= 0.0051,
+          "%s: %d pixels whose samples do not fit their level; max %d (stats %u), mean %.4f "
+          "(stats %.2f)",
+          what, bad, max, r->samples_max, mean, r->samples_mean);
 }
 
 static void aa_free(AaRender *r)
 {
     free(r->px);
     free(r->levels);
+    free(r->leaves);
     memset(r, 0, sizeof *r);
 }
 
@@ -119,6 +159,7 @@ static void test_aa_error_falls_with_threshold(void)
         if (aa_render(name, extra, 1, &r[k])) return;
         e[k] = rmse(&r[k], &ref);
         frac[k] = r[k].samples_mean / 256.0;
+        aa_check_maps(&r[k], extra);
         fprintf(stderr, "    threshold %-5g RMSE %.3e  samples/pixel %7.2f (%.4f of 16x16)\n",
                 thr[k], e[k], r[k].samples_mean, frac[k]);
     }
@@ -253,6 +294,7 @@ static void test_aa_options(void)
                          "--ssaa 0",
                          "--aa 0.1 --ssaa 4",
                          "--aa-map m.png",
+                         "--aa-samples-map s.png",
                          "--aa 0.1 --aa-map m.bmp",
                          "--aa 0.1 --aa-floor 3",
                          "--aa 0.1 --aa-level-gain 0.5"};

@@ -389,7 +389,8 @@ static void test_cli_scene_from_pipe(void)
 }
 
 /* Every output path is checked before any work (issue 17): a missing directory for the
- * image, the --aa-map or a frame exits 2 naming the path as given, writing nothing. */
+ * image, the --aa-map, the --aa-samples-map or a frame exits 2 naming the path as given,
+ * writing nothing. */
 static void test_cli_outputs_checked_first(void)
 {
     const char *scene = tu_write_file("out_good.json", GOOD_SCENE);
@@ -401,6 +402,11 @@ static void test_cli_outputs_checked_first(void)
     int rc = vbcl(args, out, sizeof out);
     CHECK(rc == 2 && strstr(out, "nodir/map.png: cannot write there") && !file_exists(img),
           "missing --aa-map directory: nothing rendered (%d): %s", rc, out);
+    snprintf(args, sizeof args, "%s -o %s --aa 0.1 --aa-samples-map %s/nodir/spp.png", scene, img,
+             tu_tmpdir());
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nodir/spp.png: cannot write there") && !file_exists(img),
+          "missing --aa-samples-map directory: nothing rendered (%d): %s", rc, out);
     snprintf(args, sizeof args, "%s -o %s/nodir/x.png", scene, tu_tmpdir());
     rc = vbcl(args, out, sizeof out);
     CHECK(rc == 2 && strstr(out, "nodir/x.png: cannot write there") && !strstr(out, ".tmp"),

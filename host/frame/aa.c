@@ -391,15 +391,28 @@ void aa_release(AaState *aa)
     memset(aa, 0, sizeof *aa);
 }
 
-void aa_level_colour(int level, float rgb[3])
+/* The palette at level position v in [0, VBCL_AA_MAX_LEVEL], blended in sRGB between the
+ * levels either side, as linear RGB. */
+static void aa_palette_at(float v, float rgb[3])
 {
     /* sRGB palette, dark to hot: 0 none, 1 2x2, 2 4x4, 3 8x8, 4 16x16 */
     static const unsigned char palette[VBCL_AA_MAX_LEVEL + 1][3] = {
         {24, 24, 48}, {40, 90, 220}, {40, 190, 80}, {250, 210, 40}, {230, 40, 40}};
-    if (level < 0) level = 0;
-    if (level > VBCL_AA_MAX_LEVEL) level = VBCL_AA_MAX_LEVEL;
+    v = fminf(fmaxf(v, 0.0f), (float)VBCL_AA_MAX_LEVEL);
+    int lo = (int)v, hi = lo < VBCL_AA_MAX_LEVEL ? lo + 1 : lo;
+    float f = v - (float)lo;
     for (int c = 0; c < 3; c++) {
-        float v = palette[level][c] / 255.0f;
-        rgb[c] = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+        float e = (palette[lo][c] * (1.0f - f) + palette[hi][c] * f) / 255.0f;
+        rgb[c] = e <= 0.04045f ? e / 12.92f : powf((e + 0.055f) / 1.055f, 2.4f);
     }
+}
+
+void aa_level_colour(int level, float rgb[3])
+{
+    aa_palette_at((float)level, rgb);
+}
+
+void aa_samples_colour(int n, float rgb[3])
+{
+    aa_palette_at(0.5f * log2f((float)(n > 1 ? n : 1)), rgb);
 }

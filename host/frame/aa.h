@@ -48,4 +48,9 @@ void aa_release(AaState *aa);
  * docs/scene-format.md): level 0 dark blue-grey through blue, green, yellow to red. */
 void aa_level_colour(int level, float rgb[3]);
 
+/* The heat-map colour of a pixel's sample count n >= 1 (its quadtree's leaves) on the same
+ * palette, at level log4(n) and blended between levels: 1 sample dark, 4 blue, 16 green,
+ * 64 yellow, 256 red. */
+void aa_samples_colour(int n, float rgb[3]);
+
 #endif

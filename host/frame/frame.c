@@ -89,6 +89,11 @@ const int *frame_levels(const Frame *fr)
     return fr->aa.levels_host;
 }
 
+const int *frame_leaves(const Frame *fr)
+{
+    return fr->aa.leaves_host;
+}
+
 void frame_release(Frame *fr)
 {
     aa_release(&fr->aa);

@@ -46,6 +46,10 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
 /* Each pixel's refinement level after an adaptive render, else NULL. */
 const int *frame_levels(const Frame *fr);
 
+/* Each pixel's number of samples (its quadtree's leaves) after an adaptive render, else
+ * NULL. */
+const int *frame_leaves(const Frame *fr);
+
 /* Releases everything frame_init and frame_render created. */
 void frame_release(Frame *fr);
 
