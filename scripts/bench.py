@@ -181,10 +181,13 @@ def part_thesis(a, out):
             opts = ["--width", str(size), "--height", str(size), "--aa", str(thr),
                     "--depth", str(depth), "-o", os.path.join(a.tmp, "thesis.exr")] + quick
             # a deeper tree or dispersion is another program: build it (and let PoCL compile
-            # its kernels) on a tiny image first, so that no row includes a cold build
-            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8", "--aa", str(thr),
-                                      "--depth", str(depth), "-o",
-                                      os.path.join(a.tmp, "warm.exr")])
+            # its kernels) first, so that no row includes a cold build: on a tiny image with
+            # the row's anti-aliasing, then unrefined at the row's size (PoCL compiles a
+            # kernel again for each work-group size it is launched with)
+            for warm in (["--width", "8", "--height", "8", "--aa", str(thr)],
+                         ["--width", str(size), "--height", str(size), "--aa", "0"]):
+                run_stats(a.vbcl, scene, warm + ["--depth", str(depth), "-o",
+                                                 os.path.join(a.tmp, "warm.exr")])
             st = median_stats(a.vbcl, scene, opts, reps)
             aa = st["aa_contrast_ms"] + st["aa_refine_ms"] + st["aa_reconstruct_ms"]
             rows.append({
