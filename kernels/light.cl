@@ -131,16 +131,34 @@ VB_INLINE int light_brdf_responds(const LightShading *ls, const ShadePoint *sp, 
 #endif
 }
 
+/* Feeler (i, j) of strata x strata of a point with this key, as (u1, u2) in the unit
+ * square. Jittered feelers of a power-of-two strata (16, the default, 4, 64, ...) are
+ * point i * strata + j of the (0, 2)-sequence, Owen-scrambled by the key: a
+ * (0, 2m, 2)-net, one point in every elementary rectangle of every shape, so a shadow edge
+ * crossing the cap at any angle is sampled more evenly than by jittered squares. Other
+ * counts are jittered in their square strata; without jitter every feeler sits at its
+ * square's centre. */
+VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int jitter)
+{
+    if (jitter && (strata & (strata - 1u)) == 0u) {
+        uint2 q = vb_sobol2(i * strata + j);
+        return (float2)(vb_unit_float(vb_owen_scramble(q.x, vb_hash(key))),
+                        vb_unit_float(vb_owen_scramble(q.y, vb_hash(key ^ 0x68bc21ebu))));
+    }
+    uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
+    return (float2)(((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata,
+                    ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata);
+}
+
 #ifdef VBCL_HAS_AREA_LIGHTS
-/* The direction of the feeler in stratum (i, j) of the cap of half-angle theta_max around
- * wc (frame tx, ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle, at a
- * jittered point of the stratum or at its centre. */
+/* The direction of feeler (i, j) on the cap of half-angle theta_max around wc (frame tx,
+ * ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle over (u1, u2) of
+ * light_cap_uv, u1 the cosine's share and u2 the turn. */
 VB_INLINE float3 light_cap_direction(uint i, uint j, uint strata, uint key, int jitter,
                                      float one_minus_cos, float3 tx, float3 ty, float3 wc)
 {
-    uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
-    float u1 = ((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata;
-    float u2 = ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata;
+    float2 u = light_cap_uv(i, j, strata, key, jitter);
+    float u1 = u.x, u2 = u.y;
     float cos_t = 1.0f - u1 * one_minus_cos;
     float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
     float phi = 2.0f * VB_PI * u2;

@@ -89,6 +89,18 @@ __kernel void probe_optics(__global const float *in, int n, __global float *out)
     vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);
 }
 
+/* The feelers' (u1, u2) of light_cap_uv for keys key0 .. key0 + nkeys - 1: strata^2 pairs
+ * per key, row-major (i, j). */
+__kernel void probe_cap_uv(uint strata, uint key0, uint nkeys, int jitter, __global float *out)
+{
+    uint k = get_global_id(0);
+    if (k >= nkeys) return;
+    for (uint i = 0; i < strata; i++)
+        for (uint j = 0; j < strata; j++)
+            vstore2(light_cap_uv(i, j, strata, key0 + k, jitter), (k * strata + i) * strata + j,
+                    out);
+}
+
 /* shear constants and single-triangle tests for the watertightness checks:
  * rays x triangles -> 1 if hit. */
 __kernel void probe_hit_matrix(__global const VbTriangle *tris, uint ntris,

@@ -442,6 +442,84 @@ static void test_light_irradiance_closed_form(void)
     fixture_close(&fx);
 }
 
+/* Runs probe_cap_uv: nkeys x strata^2 (u1, u2) pairs into uv. Returns 0 or -1. */
+static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int jitter, float *uv)
+{
+    size_t n = (size_t)nkeys * strata * strata;
+    cl_mem mo = buffer(NULL, sizeof(float) * 2 * n);
+    unsigned key0 = 12345;
+    const size_t sz[] = {sizeof(unsigned), sizeof(unsigned), sizeof(unsigned), sizeof(int),
+                         sizeof(cl_mem)};
+    const void *v[] = {&strata, &key0, &nkeys, &jitter, &mo};
+    int rc = run_kernel(fx->r.program, "probe_cap_uv", nkeys, 5, sz, v);
+    read_buffer(mo, uv, sizeof(float) * 2 * n);
+    clReleaseMemObject(mo);
+    return rc;
+}
+
+/* The feelers' positions on the cap's unit square (light_cap_uv), for 256 points' keys:
+ * with a power-of-two strata (4, 16, 64 feelers) each point's set is a (0, 2m, 2)-net, one
+ * feeler in each cell of every elementary grid 2^a x 2^b (a + b = 2m), and the sets differ
+ * from key to key (the scramble); the mean of u1 and u2 over all is 1/2 within 0.01. With 9
+ * feelers each lies in its own third x third square; without jitter at the squares'
+ * centres. */
+static void test_light_feelers_net(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{" CAM "\"materials\": {\"m\": {}}, \"objects\": "
+                          "[{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    enum { KEYS = 256 };
+    static float uv[KEYS * 64 * 2];
+    const unsigned stratas[] = {2, 4, 8};
+    for (size_t s = 0; s < sizeof stratas / sizeof stratas[0]; s++) {
+        unsigned n = stratas[s] * stratas[s], m2 = 0;
+        while ((1u << m2) < n) m2++;
+        if (cap_uv(&fx, stratas[s], KEYS, 1, uv)) break;
+        int bad = 0, distinct = 0;
+        double mean[2] = {0, 0};
+        for (int k = 0; k < KEYS; k++) {
+            const float *p = uv + (size_t)k * n * 2;
+            for (unsigned a = 0; a <= m2; a++) { /* grid 2^a x 2^(m2 - a) */
+                int seen[64] = {0};
+                for (unsigned q = 0; q < n; q++) {
+                    int cx = (int)(p[2 * q] * (float)(1u << a));
+                    int cy = (int)(p[2 * q + 1] * (float)(1u << (m2 - a)));
+                    seen[cx * (1 << (m2 - a)) + cy]++;
+                }
+                for (unsigned c = 0; c < n; c++) bad += seen[c] != 1;
+            }
+            for (unsigned q = 0; q < n; q++) mean[0] += p[2 * q], mean[1] += p[2 * q + 1];
+            distinct += k > 0 && p[0] != uv[0];
+        }
+        mean[0] /= (double)KEYS * n, mean[1] /= (double)KEYS * n;
+        fprintf(stderr, "    %u feelers: %d cells not holding one point, mean (%.4f, %.4f)\n", n,
+                bad, mean[0], mean[1]);
+        CHECK(bad == 0 && fabs(mean[0] - 0.5) < 0.01 && fabs(mean[1] - 0.5) < 0.01 &&
+                  distinct > KEYS - 4,
+              "%u feelers: %d empty or doubled cells, mean (%g, %g), %d of %d keys move the "
+              "first point",
+              n, bad, mean[0], mean[1], distinct, KEYS - 1);
+    }
+    for (int jitter = 1; jitter >= 0; jitter--) {
+        if (cap_uv(&fx, 3, KEYS, jitter, uv)) break;
+        int bad = 0;
+        for (int k = 0; k < KEYS; k++)
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++) {
+                    const float *p = uv + ((size_t)k * 9 + (size_t)(i * 3 + j)) * 2;
+                    if (jitter)
+                        bad += (int)(p[0] * 3.0f) != i || (int)(p[1] * 3.0f) != j;
+                    else
+                        bad += fabsf(p[0] - (i + 0.5f) / 3.0f) > 1e-6f ||
+                               fabsf(p[1] - (j + 0.5f) / 3.0f) > 1e-6f;
+                }
+        CHECK(bad == 0, "9 feelers, jitter %d: %d outside their squares or off centre", jitter,
+              bad);
+    }
+    fixture_close(&fx);
+}
+
 /* Rays aimed exactly at every vertex and every edge midpoint of closed meshes, from
  * outside toward the centre, must all hit: none slips between two triangles. */
 static void test_rays_at_edges_and_vertices_hit(void)
@@ -547,5 +625,6 @@ void suite_kernels(void)
     RUN_TEST(test_grid_cell_box_range);
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
+    RUN_TEST(test_light_feelers_net);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
 }
