@@ -131,20 +131,31 @@ VB_INLINE int light_brdf_responds(const LightShading *ls, const ShadePoint *sp, 
 #endif
 }
 
-/* Feeler (i, j) of strata x strata of a point with this key, as (u1, u2) in the unit
- * square. Jittered feelers of a power-of-two strata (16, the default, 4, 64, ...) are
- * point i * strata + j of the (0, 2)-sequence, Owen-scrambled by the key: a
- * (0, 2m, 2)-net, one point in every elementary rectangle of every shape, so a shadow edge
- * crossing the cap at any angle is sampled more evenly than by jittered squares. Other
- * counts are jittered in their square strata; without jitter every feeler sits at its
- * square's centre. */
-VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int jitter)
+/* How a point's feelers are placed, from the frame's flags: LIGHT_FEELERS_NET for jittered
+ * feelers of a power-of-two side (the host decides, VBCL_FRAME_NET_FEELERS), _JITTERED
+ * for other jittered ones, _FIXED at the strata's centres. */
+enum { LIGHT_FEELERS_FIXED = 0, LIGHT_FEELERS_JITTERED = 1, LIGHT_FEELERS_NET = 2 };
+VB_INLINE int light_feeler_mode(uint flags)
 {
-    if (jitter && (strata & (strata - 1u)) == 0u) {
+    return (flags & VBCL_FRAME_FIXED_FEELERS) ? LIGHT_FEELERS_FIXED
+           : (flags & VBCL_FRAME_NET_FEELERS) ? LIGHT_FEELERS_NET
+                                              : LIGHT_FEELERS_JITTERED;
+}
+
+/* Feeler (i, j) of strata x strata of a point with this key, as (u1, u2) in the unit
+ * square. LIGHT_FEELERS_NET (strata a power of two: 16, the default, 4, 64, ...): point
+ * i * strata + j of the (0, 2)-sequence, Owen-scrambled by the key, a (0, 2m, 2)-net with
+ * one point in every elementary rectangle of every shape, so a shadow edge crossing the
+ * cap at any angle is sampled more evenly than by jittered squares. _JITTERED: a random
+ * point of square stratum (i, j); _FIXED: its centre. */
+VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int mode)
+{
+    if (mode == LIGHT_FEELERS_NET) {
         uint2 q = vb_sobol2(i * strata + j);
         return (float2)(vb_unit_float(vb_owen_scramble(q.x, vb_hash(key))),
                         vb_unit_float(vb_owen_scramble(q.y, vb_hash(key ^ 0x68bc21ebu))));
     }
+    int jitter = mode == LIGHT_FEELERS_JITTERED;
     uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
     return (float2)(((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata,
                     ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata);
@@ -154,10 +165,10 @@ VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int jitter)
 /* The direction of feeler (i, j) on the cap of half-angle theta_max around wc (frame tx,
  * ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle over (u1, u2) of
  * light_cap_uv, u1 the cosine's share and u2 the turn. */
-VB_INLINE float3 light_cap_direction(uint i, uint j, uint strata, uint key, int jitter,
+VB_INLINE float3 light_cap_direction(uint i, uint j, uint strata, uint key, int mode,
                                      float one_minus_cos, float3 tx, float3 ty, float3 wc)
 {
-    float2 u = light_cap_uv(i, j, strata, key, jitter);
+    float2 u = light_cap_uv(i, j, strata, key, mode);
     float u1 = u.x, u2 = u.y;
     float cos_t = 1.0f - u1 * one_minus_cos;
     float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
@@ -173,7 +184,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                                     TraceCount *tc, ShadowCount *sc)
 {
     uint strata = scn->f->shadow_strata;
-    int jitter = !(scn->f->flags & VBCL_FRAME_FIXED_FEELERS);
+    int mode = light_feeler_mode(scn->f->flags);
     float3 wc = ls->to_c / ls->d;
     float sin_max = r / ls->d;
     if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
@@ -190,7 +201,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
 #endif
     for (uint i = 0; i < strata; i++) {
         for (uint j = 0; j < strata; j++) {
-            float3 w = light_cap_direction(i, j, strata, key, jitter, one_minus_cos, tx, ty, wc);
+            float3 w = light_cap_direction(i, j, strata, key, mode, one_minus_cos, tx, ty, wc);
             float cos_n = dot(sp->ns, w);
             if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
                 sc->skipped++;
@@ -224,8 +235,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
 #endif
 
 /* Reflected radiance toward wo from one light: the cap of the light sphere visible from
- * the point is sampled at strata^2 stratified directions (jittered inside their strata, or
- * at the strata's centres with VBCL_FRAME_FIXED_FEELERS); each direction's feeler is
+ * the point is sampled at strata^2 directions (light_cap_uv: a scrambled net, jittered
+ * strata, or the strata's centres with VBCL_FRAME_FIXED_FEELERS); each direction's feeler is
  * traced to the sphere and the unoccluded fraction of the BRDF-weighted integral is kept:
  * L * Omega * mean(V * f * cos). Lights wholly behind the surface cost no feelers. A light
  * of radius 0 is a point light. */

@@ -89,16 +89,15 @@ __kernel void probe_optics(__global const float *in, int n, __global float *out)
     vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);
 }
 
-/* The feelers' (u1, u2) of light_cap_uv for keys key0 .. key0 + nkeys - 1: strata^2 pairs
- * per key, row-major (i, j). */
-__kernel void probe_cap_uv(uint strata, uint key0, uint nkeys, int jitter, __global float *out)
+/* The feelers' (u1, u2) of light_cap_uv (mode LIGHT_FEELERS_*) for keys key0 .. key0 +
+ * nkeys - 1: strata^2 pairs per key, row-major (i, j). */
+__kernel void probe_cap_uv(uint strata, uint key0, uint nkeys, int mode, __global float *out)
 {
     uint k = get_global_id(0);
     if (k >= nkeys) return;
     for (uint i = 0; i < strata; i++)
         for (uint j = 0; j < strata; j++)
-            vstore2(light_cap_uv(i, j, strata, key0 + k, jitter), (k * strata + i) * strata + j,
-                    out);
+            vstore2(light_cap_uv(i, j, strata, key0 + k, mode), (k * strata + i) * strata + j, out);
 }
 
 /* shear constants and single-triangle tests for the watertightness checks:
@@ -274,7 +273,7 @@ VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, const 
     float3 origin = ls->origin, to_c = ls->to_c;
     float d2 = ls->d2, d = ls->d;
     uint strata = sc->f->shadow_strata;
-    int jitter = !(sc->f->flags & VBCL_FRAME_FIXED_FEELERS);
+    int mode = light_feeler_mode(sc->f->flags);
     float3 wc = to_c / d;
     if (dot(sp->ng, wc) < -(r / d)) return 0;
     float one_minus_cos = light_cap_solid_angle(r, d) * (1.0f / (2.0f * VB_PI));
@@ -283,7 +282,7 @@ VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, const 
     int k = 0;
     for (uint i = 0; i < strata; i++)
         for (uint j = 0; j < strata; j++) {
-            float3 w = light_cap_direction(i, j, strata, key, jitter, one_minus_cos, tx, ty, wc);
+            float3 w = light_cap_direction(i, j, strata, key, mode, one_minus_cos, tx, ty, wc);
             float nh;
             if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
             if (!light_brdf_responds(ls, sp, w, &nh)) continue; /* unneeded: not traced */

@@ -22,14 +22,20 @@ VB_INLINE float vb_unit_float(uint h)
     return (float)(h >> 8) * (1.0f / 16777216.0f);
 }
 
-/* The bits of x in reverse order. */
+/* Each byte with its bits in reverse order. */
+#define VB_REV2(n) n, n + 2 * 64, n + 1 * 64, n + 3 * 64
+#define VB_REV4(n) VB_REV2(n), VB_REV2(n + 2 * 16), VB_REV2(n + 1 * 16), VB_REV2(n + 3 * 16)
+#define VB_REV6(n) VB_REV4(n), VB_REV4(n + 2 * 4), VB_REV4(n + 1 * 4), VB_REV4(n + 3 * 4)
+__constant uchar vb_byte_reversed[256] = {VB_REV6(0), VB_REV6(2), VB_REV6(1), VB_REV6(3)};
+
+/* The bits of x in reverse order, by bytes from a table: the shift-and-mask form compiles
+ * to LLVM's bitreverse intrinsic, which not every OpenCL implementation provides
+ * (Oclgrind does not). */
 VB_INLINE uint vb_reverse_bits(uint x)
 {
-    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-    return (x >> 16) | (x << 16);
+    return ((uint)vb_byte_reversed[x & 0xffu] << 24) |
+           ((uint)vb_byte_reversed[(x >> 8) & 0xffu] << 16) |
+           ((uint)vb_byte_reversed[(x >> 16) & 0xffu] << 8) | (uint)vb_byte_reversed[x >> 24];
 }
 
 /* Owen's nested scrambling of a coordinate in 32-bit fixed point, keyed by seed (Burley

@@ -231,6 +231,7 @@ typedef struct VbFrame {
 
 /* VbFrame.flags */
 #define VBCL_FRAME_FIXED_FEELERS 1u /* shadow feelers at stratum centres, the same everywhere */
+#define VBCL_FRAME_NET_FEELERS   2u /* jittered feelers of a power-of-two side: a scrambled net */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
  * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second

@@ -442,15 +442,16 @@ static void test_light_irradiance_closed_form(void)
     fixture_close(&fx);
 }
 
-/* Runs probe_cap_uv: nkeys x strata^2 (u1, u2) pairs into uv. Returns 0 or -1. */
-static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int jitter, float *uv)
+/* Runs probe_cap_uv (mode LIGHT_FEELERS_*: 0 fixed, 1 jittered, 2 net): nkeys x strata^2
+ * (u1, u2) pairs into uv. Returns 0 or -1. */
+static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int mode, float *uv)
 {
     size_t n = (size_t)nkeys * strata * strata;
     cl_mem mo = buffer(NULL, sizeof(float) * 2 * n);
     unsigned key0 = 12345;
     const size_t sz[] = {sizeof(unsigned), sizeof(unsigned), sizeof(unsigned), sizeof(int),
                          sizeof(cl_mem)};
-    const void *v[] = {&strata, &key0, &nkeys, &jitter, &mo};
+    const void *v[] = {&strata, &key0, &nkeys, &mode, &mo};
     int rc = run_kernel(fx->r.program, "probe_cap_uv", nkeys, 5, sz, v);
     read_buffer(mo, uv, sizeof(float) * 2 * n);
     clReleaseMemObject(mo);
@@ -462,7 +463,8 @@ static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int jitter, floa
  * feeler in each cell of every elementary grid 2^a x 2^b (a + b = 2m), and the sets differ
  * from key to key (the scramble); the mean of u1 and u2 over all is 1/2 within 0.01. With 9
  * feelers each lies in its own third x third square; without jitter at the squares'
- * centres. */
+ * centres. The host picks the net for 16 feelers (the default), not for 9, nor with
+ * shadow_jitter false. */
 static void test_light_feelers_net(void)
 {
     Fixture fx;
@@ -475,7 +477,7 @@ static void test_light_feelers_net(void)
     for (size_t s = 0; s < sizeof stratas / sizeof stratas[0]; s++) {
         unsigned n = stratas[s] * stratas[s], m2 = 0;
         while ((1u << m2) < n) m2++;
-        if (cap_uv(&fx, stratas[s], KEYS, 1, uv)) break;
+        if (cap_uv(&fx, stratas[s], KEYS, 2, uv)) break;
         int bad = 0, distinct = 0;
         double mean[2] = {0, 0};
         for (int k = 0; k < KEYS; k++) {
@@ -517,7 +519,22 @@ static void test_light_feelers_net(void)
         CHECK(bad == 0, "9 feelers, jitter %d: %d outside their squares or off centre", jitter,
               bad);
     }
+    CHECK(fx.r.frame_host.flags == VBCL_FRAME_NET_FEELERS, "16 feelers: frame flags %u",
+          fx.r.frame_host.flags);
     fixture_close(&fx);
+    const char *other[2] = {"\"shadow_samples\": 9", "\"shadow_jitter\": false"};
+    const unsigned want[2] = {0u, VBCL_FRAME_FIXED_FEELERS};
+    for (int k = 0; k < 2; k++) {
+        char json[512];
+        snprintf(json, sizeof json,
+                 "{" CAM "\"render\": {%s}, \"materials\": {\"m\": {}}, "
+                 "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}",
+                 other[k]);
+        if (fixture_open(&fx, json)) return;
+        CHECK(fx.r.frame_host.flags == want[k], "%s: frame flags %u, want %u", other[k],
+              fx.r.frame_host.flags, want[k]);
+        fixture_close(&fx);
+    }
 }
 
 /* Rays aimed exactly at every vertex and every edge midpoint of closed meshes, from

@@ -300,7 +300,12 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
     f->shadow_strata = strata < 1 ? 1 : strata;
     f->seed = s->seed;
-    f->flags = s->shadow_jitter ? 0u : VBCL_FRAME_FIXED_FEELERS;
+    /* n x n feelers with n a power of two are a scrambled (0, 2)-net (light_cap_uv); the
+     * test is made here, since a popcount in the kernel is an LLVM intrinsic that some
+     * OpenCL implementations (Oclgrind) do not provide */
+    f->flags = !s->shadow_jitter                             ? VBCL_FRAME_FIXED_FEELERS
+               : (f->shadow_strata & (f->shadow_strata - 1)) ? 0u
+                                                             : VBCL_FRAME_NET_FEELERS;
     scene_medium_at(s, s->eye, &f->camera_medium);
     f->air_material = (unsigned)s->nmaterials;
     f->min_weight = s->min_weight;
