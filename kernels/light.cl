@@ -142,21 +142,42 @@ VB_INLINE int light_feeler_mode(uint flags)
                                               : LIGHT_FEELERS_JITTERED;
 }
 
-/* Feeler (i, j) of strata x strata of a point with this key, as (u1, u2) in the unit
- * square. LIGHT_FEELERS_NET (strata a power of two: 16, the default, 4, 64, ...): point
+/* One point's feelers toward one light: how they are placed (LIGHT_FEELERS_*), the
+ * point's key and, for the net, its two scramble seeds, hashed once per point rather than
+ * once per feeler. */
+typedef struct CapFeelers {
+    int mode;
+    uint strata; /* strata x strata feelers */
+    uint key;
+    uint seed_u, seed_v;
+} CapFeelers;
+
+VB_INLINE CapFeelers light_cap_feelers(int mode, uint strata, uint key)
+{
+    CapFeelers cf = {mode, strata, key, 0u, 0u};
+    if (mode == LIGHT_FEELERS_NET) {
+        cf.seed_u = vb_hash(key);
+        cf.seed_v = vb_hash(key ^ 0x68bc21ebu);
+    }
+    return cf;
+}
+
+/* Feeler (i, j) of the point's strata x strata, as (u1, u2) in the unit square.
+ * LIGHT_FEELERS_NET (strata a power of two: 16, the default, 4, 64, ...): point
  * i * strata + j of the (0, 2)-sequence, Owen-scrambled by the key, a (0, 2m, 2)-net with
  * one point in every elementary rectangle of every shape, so a shadow edge crossing the
  * cap at any angle is sampled more evenly than by jittered squares. _JITTERED: a random
  * point of square stratum (i, j); _FIXED: its centre. */
-VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int mode)
+VB_INLINE float2 light_cap_uv(const CapFeelers *cf, uint i, uint j)
 {
-    if (mode == LIGHT_FEELERS_NET) {
+    uint strata = cf->strata;
+    if (cf->mode == LIGHT_FEELERS_NET) {
         uint2 q = vb_sobol2(i * strata + j);
-        return (float2)(vb_unit_float(vb_owen_scramble(q.x, vb_hash(key))),
-                        vb_unit_float(vb_owen_scramble(q.y, vb_hash(key ^ 0x68bc21ebu))));
+        return (float2)(vb_unit_float(vb_owen_scramble(q.x, cf->seed_u)),
+                        vb_unit_float(vb_owen_scramble(q.y, cf->seed_v)));
     }
-    int jitter = mode == LIGHT_FEELERS_JITTERED;
-    uint h = vb_hash(key ^ vb_hash(i * strata + j + 0x9e3779b9u));
+    int jitter = cf->mode == LIGHT_FEELERS_JITTERED;
+    uint h = vb_hash(cf->key ^ vb_hash(i * strata + j + 0x9e3779b9u));
     return (float2)(((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata,
                     ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata);
 }
@@ -165,10 +186,10 @@ VB_INLINE float2 light_cap_uv(uint i, uint j, uint strata, uint key, int mode)
 /* The direction of feeler (i, j) on the cap of half-angle theta_max around wc (frame tx,
  * ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle over (u1, u2) of
  * light_cap_uv, u1 the cosine's share and u2 the turn. */
-VB_INLINE float3 light_cap_direction(uint i, uint j, uint strata, uint key, int mode,
-                                     float one_minus_cos, float3 tx, float3 ty, float3 wc)
+VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float one_minus_cos,
+                                     float3 tx, float3 ty, float3 wc)
 {
-    float2 u = light_cap_uv(i, j, strata, key, mode);
+    float2 u = light_cap_uv(cf, i, j);
     float u1 = u.x, u2 = u.y;
     float cos_t = 1.0f - u1 * one_minus_cos;
     float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
@@ -184,7 +205,6 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                                     TraceCount *tc, ShadowCount *sc)
 {
     uint strata = scn->f->shadow_strata;
-    int mode = light_feeler_mode(scn->f->flags);
     float3 wc = ls->to_c / ls->d;
     float sin_max = r / ls->d;
     if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
@@ -195,13 +215,14 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
     float3 tx, ty;
     vb_frame(wc, &tx, &ty);
+    CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
 #endif
     for (uint i = 0; i < strata; i++) {
         for (uint j = 0; j < strata; j++) {
-            float3 w = light_cap_direction(i, j, strata, key, mode, one_minus_cos, tx, ty, wc);
+            float3 w = light_cap_direction(&cf, i, j, one_minus_cos, tx, ty, wc);
             float cos_n = dot(sp->ns, w);
             if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
                 sc->skipped++;

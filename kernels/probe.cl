@@ -95,9 +95,10 @@ __kernel void probe_cap_uv(uint strata, uint key0, uint nkeys, int mode, __globa
 {
     uint k = get_global_id(0);
     if (k >= nkeys) return;
+    CapFeelers cf = light_cap_feelers(mode, strata, key0 + k);
     for (uint i = 0; i < strata; i++)
         for (uint j = 0; j < strata; j++)
-            vstore2(light_cap_uv(i, j, strata, key0 + k, mode), (k * strata + i) * strata + j, out);
+            vstore2(light_cap_uv(&cf, i, j), (k * strata + i) * strata + j, out);
 }
 
 /* shear constants and single-triangle tests for the watertightness checks:
@@ -273,16 +274,16 @@ VB_INLINE int probe_cap_feelers(const DevScene *sc, const ShadePoint *sp, const 
     float3 origin = ls->origin, to_c = ls->to_c;
     float d2 = ls->d2, d = ls->d;
     uint strata = sc->f->shadow_strata;
-    int mode = light_feeler_mode(sc->f->flags);
     float3 wc = to_c / d;
     if (dot(sp->ng, wc) < -(r / d)) return 0;
     float one_minus_cos = light_cap_solid_angle(r, d) * (1.0f / (2.0f * VB_PI));
     float3 tx, ty;
     vb_frame(wc, &tx, &ty);
+    CapFeelers cf = light_cap_feelers(light_feeler_mode(sc->f->flags), strata, key);
     int k = 0;
     for (uint i = 0; i < strata; i++)
         for (uint j = 0; j < strata; j++) {
-            float3 w = light_cap_direction(i, j, strata, key, mode, one_minus_cos, tx, ty, wc);
+            float3 w = light_cap_direction(&cf, i, j, one_minus_cos, tx, ty, wc);
             float nh;
             if (dot(sp->ns, w) <= 0.0f || dot(sp->ng, w) <= 0.0f) continue;
             if (!light_brdf_responds(ls, sp, w, &nh)) continue; /* unneeded: not traced */
