@@ -53,6 +53,8 @@ static const char usage_text[] =
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --subgrid-density D  sub-cells per triangle of a crowded top cell (default 2)\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
+    "      --no-cone-test       trace every feeler, also where the cone from the point to\n"
+    "                           the light meets no object's bounds (same image, slower)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
     "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
     "      --fresnel exact|thesis  energy split at interfaces: Fresnel, or thesis eq. 9\n"
@@ -96,7 +98,7 @@ typedef struct Options {
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
-    int list_devices, stats, quiet;
+    int list_devices, stats, quiet, no_cone_test;
 } Options;
 
 static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -169,6 +171,7 @@ static const OptionSpec option_specs[] = {
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
     {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
     {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
+    {"--no-cone-test", NULL, OPT_FLAG, offsetof(Options, no_cone_test), 0, 0},
     {"--stats", NULL, OPT_FLAG, offsetof(Options, stats), 0, 0},
     {"--quiet", "-q", OPT_FLAG, offsetof(Options, quiet), 0, 0},
 };
@@ -374,6 +377,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->aa >= 0) s->aa_threshold = (float)o->aa;
     if (o->aa_floor >= 0) s->aa_floor = (float)o->aa_floor;
     if (o->aa_level_gain > 0) s->aa_level_gain = (float)o->aa_level_gain;
+    if (o->no_cone_test) s->shadow_cone_test = 0;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
     if (o->bands >= 0) {
         s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;

@@ -114,9 +114,10 @@ void stats_print(FILE *f, const StatsFrame *fr)
     print_setup(f, fr);
     fprintf(f,
             "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point; %llu "
-            "skipped: light behind the surface; %llu unneeded: no BRDF response), total %llu\n",
+            "skipped: light behind the surface; %llu clear: not traced, their cone meets no "
+            "object; %llu unneeded: no BRDF response), total %llu\n",
             st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata, st->shadow_skipped,
-            st->shadow_unneeded, rays);
+            st->shadow_clear, st->shadow_unneeded, rays);
     if (st->features & VBCL_FEATURE_TRANSPARENCY) print_tree(f, s, st);
     if (st->features & (VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_TEXTURES))
         fprintf(f, "media       %llu crossings passed through (no change of material)\n",

@@ -145,6 +145,38 @@ VB_INLINE void grid_sub_begin(__constant const VbGrid *g, const GridWalk *top, i
     s->axis = -1;
 }
 
+/* No hit yet, within tmax. */
+VB_INLINE void closest_begin(Closest *c, float tmax)
+{
+    c->hit.t = tmax;
+    c->hit.tri = -1;
+    c->hit.u = c->hit.v = 0.0f;
+    c->opaque = 0u;
+    c->window = 0.0f;
+    c->reach = tmax;
+}
+
+/* Tests triangle tri for the closest hit, updating *c (ties: the lower index, so the
+ * order of the tests does not matter). */
+VB_INLINE void closest_test(const RayShear *rs, float3 org, float tmax,
+                            __global const VbTriangle *tris, int tri, Closest *c)
+{
+    float t, u, v;
+    if (tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                      tri_vertex(tris, tri, 2), c->reach, &t, &u, &v)) {
+        uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
+        if (hit_before(t, tri, opaque, c->hit, c->opaque, c->window)) {
+            c->hit.t = t;
+            c->hit.tri = tri;
+            c->hit.u = u;
+            c->hit.v = v;
+            c->opaque = opaque;
+            c->window = hit_contact_window(org, t);
+            c->reach = hit_reach(c->hit, c->opaque, c->window, tmax);
+        }
+    }
+}
+
 /* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
  * updating *c. Returns the number of tests. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
@@ -152,23 +184,7 @@ VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
                                  __global const uint *leaf_tris, uint leaf, Closest *c)
 {
     uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
-    for (uint k = begin; k < end; k++) {
-        int tri = (int)leaf_tris[k];
-        float t, u, v;
-        if (tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                          tri_vertex(tris, tri, 2), c->reach, &t, &u, &v)) {
-            uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
-            if (hit_before(t, tri, opaque, c->hit, c->opaque, c->window)) {
-                c->hit.t = t;
-                c->hit.tri = tri;
-                c->hit.u = u;
-                c->hit.v = v;
-                c->opaque = opaque;
-                c->window = hit_contact_window(org, t);
-                c->reach = hit_reach(c->hit, c->opaque, c->window, tmax);
-            }
-        }
-    }
+    for (uint k = begin; k < end; k++) closest_test(rs, org, tmax, tris, (int)leaf_tris[k], c);
     return end - begin;
 }
 
@@ -183,12 +199,7 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
                                    float3 org, float3 dir, float tmax, TraceCount *count)
 {
     Closest c;
-    c.hit.t = tmax;
-    c.hit.tri = -1;
-    c.hit.u = c.hit.v = 0.0f;
-    c.opaque = 0u;
-    c.window = 0.0f;
-    c.reach = tmax;
+    closest_begin(&c, tmax);
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return c.hit;
     RayShear rs = ray_shear_make(org, dir);

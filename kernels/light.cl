@@ -37,16 +37,19 @@ typedef struct ShadePoint {
     uint key;        /* decorrelates this point's random jitter */
     VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
     float scale;     /* largest vertex coordinate of the triangle: sizes the ray offsets */
+    int object;      /* the object whose surface it is, or -1: not known, or a texture's */
+    int front;       /* ng is the triangle's own normal (outward, on a closed object) */
     int band;        /* wavelength band of the ray that found it, or -1: white */
 } ShadePoint;
 
 /* What a shadow feeler from sp lets through toward a light at distance t: 0 or 1, or,
- * with transparent objects, the transmittance of the interfaces and media it crosses. */
-VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 origin, float3 w,
-                              float t, TraceCount *tc)
+ * with transparent objects, the transmittance of the interfaces and media it crosses; only
+ * the objects of os can stop it (os->n < 0: any object, through the grid). */
+VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, const ObjectSet *os,
+                              float3 origin, float3 w, float t, TraceCount *tc)
 {
 #ifdef VBCL_HAS_TRANSPARENCY
-    return medium_shadow_transmittance(sc, origin, w, t, sp->medium, sp->band, tc);
+    return medium_shadow_transmittance(sc, os, origin, w, t, sp->medium, sp->band, tc);
 #else
     (void)sp;
 #ifdef VBCL_HAS_TEXTURES
@@ -58,18 +61,35 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, float3 o
 #else
     const uint skip = 0u;
 #endif
-    return scene_trace_any(sc, origin, w, t, skip, tc) ? (float3)(0.0f) : (float3)(1.0f);
+    return scene_trace_any_in(sc, os, origin, w, t, skip, tc) ? (float3)(0.0f) : (float3)(1.0f);
+#endif
+}
+
+/* What a feeler from sp that meets no surface lets through over distance t: all of it,
+ * or with transparent objects what the medium it starts in absorbs, exactly as
+ * light_feeler computes it when its walk finds nothing. */
+VB_INLINE float3 light_feeler_open(const DevScene *sc, const ShadePoint *sp, float t)
+{
+#ifdef VBCL_HAS_TRANSPARENCY
+    return (float3)(1.0f) * medium_absorb(sc, medium_material(sc, sp->medium), t);
+#else
+    (void)sc;
+    (void)sp;
+    (void)t;
+    return (float3)(1.0f);
 #endif
 }
 
 /* Counts of one work item's shadow feelers, summed by the caller: traced; skipped, the
  * light being below the surface's horizon; unneeded, the BRDF giving the direction
  * nothing (no diffuse term, and outside the specular lobe: (N.H)^n < 1e-4), so that
- * whether the light is visible there changes nothing. */
+ * whether the light is visible there changes nothing; clear, not traced because the cone
+ * they lie in meets no object (light_cone_objects). */
 typedef struct ShadowCount {
     uint traced;
     uint skipped;
     uint unneeded;
+    uint clear;
 } ShadowCount;
 
 /* What shading a point under one light needs besides the point itself: the BRDF's
@@ -113,6 +133,94 @@ VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 d
 #endif
     ls.origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
     return ls;
+}
+
+/* Whether the cone from o around the unit axis, of half-angle theta (tan_t = tan theta), up
+ * to distance d, can meet the box [lo, hi]: the cone is cut into 4 pieces along the axis,
+ * and piece i, between distances d i / 4 and d (i + 1) / 4, lies within d (i + 1) / 4 tan_t
+ * of the axis, so it can meet the box only if that stretch of the axis meets the box widened
+ * by this radius and the margin m (slab test). Conservative: true where unsure. */
+VB_INLINE int light_cone_meets_box(float3 o, float3 axis, float d, float tan_t, float3 lo,
+                                   float3 hi, float m)
+{
+    float3 inv = 1.0f / axis;
+    int3 flat = isless(fabs(axis), (float3)(1e-12f));
+    for (int i = 0; i < 4; i++) {
+        float t0 = d * 0.25f * (float)i, t1 = d * 0.25f * (float)(i + 1);
+        float rad = t1 * tan_t + m;
+        float3 a = (lo - rad - o) * inv, b = (hi + rad - o) * inv;
+        float3 tn = fmin(a, b), tf = fmax(a, b);
+        /* an axis the direction runs along: the stretch lies inside its slab or outside */
+        int3 inside = isgreaterequal(o, lo - rad) & islessequal(o, hi + rad);
+        tn = select(tn, select((float3)(INFINITY), (float3)(-INFINITY), inside), flat);
+        tf = select(tf, select((float3)(-INFINITY), (float3)(INFINITY), inside), flat);
+        float enter = fmax(fmax(tn.x, tn.y), fmax(tn.z, t0 - m));
+        float leave = fmin(fmin(tf.x, tf.y), fmin(tf.z, t1 + m));
+        if (enter <= leave) return 1;
+    }
+    return 0;
+}
+
+/* The objects that feelers from ls->origin toward the light sphere (radius r, 0 for a point
+ * light) may meet (VBCL_FRAME_CONE_TEST; the host sets it for scenes of at most
+ * VBCL_CONE_TEST_MAX_OBJECTS objects): none, so that no feeler need be traced; a few small
+ * ones (at most VB_OBJECT_SET_MAX objects of VB_OBJECT_SET_MAX_TRIS triangles in all), whose
+ * triangles alone each feeler then tests, without walking the grid; or n = -1, the grid
+ * (too many, or the test off). Every feeler lies in the cone
+ * from the origin around the direction to the light's centre, of half-angle theta with
+ * sin theta = r / d, and ends before distance d; an object can stop one only if its
+ * bounding sphere meets that cone within that length (the sphere's centre no farther
+ * from the cone's surface than its radius: perp cos theta - along sin theta <= R, a lower
+ * bound of the distance, so the test is conservative), and, for a planar object, only if
+ * its plane separates the origin from some point of the light sphere. The point's own
+ * object cannot when it is planar (a feeler is traced only toward the side of the surface
+ * it leaves from), nor when it is convex and the feeler leaves from the front of its
+ * triangle: all of the object lies behind that triangle's plane. Margins (1e-5 of the
+ * distances, the host's planarity margin) keep float rounding on the safe side: an object
+ * left out is one no feeler's walk would meet, and the image is the same as with every
+ * feeler walked through the grid. */
+VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, const LightShading *ls,
+                                  float r, ObjectSet *os)
+{
+    os->n = -1;
+    if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return;
+    os->n = 0;
+    uint tris = 0u;
+    float3 o = ls->origin;
+    float3 axis = ls->to_c / ls->d;
+    float3 c = sp->p + ls->to_c;
+    float sin_t = fmin(1.0f, r / ls->d);
+    float cos_t = sqrt(fmax(0.0f, 1.0f - sin_t * sin_t));
+    float reach = vb_max3(fabs(o)) + vb_max3(fabs(c)) + r;
+    for (uint k = 0; k < scn->f->nobjects; k++) {
+        __global const VbObject *ob = scn->objects + k;
+        uint planar = ob->flags & VBCL_OBJECT_PLANAR;
+        if ((int)k == sp->object && (planar || ((ob->flags & VBCL_OBJECT_CONVEX) && sp->front)))
+            continue;
+        float4 b = vload4(0, ob->bound);
+        if (b.w < 0.0f) continue;
+        float3 v = b.xyz - o;
+        float along = dot(v, axis);
+        float3 across = v - along * axis;
+        float m = b.w + 1e-5f * (ls->d + fabs(along) + length(across) + b.w);
+        if (along < -m || along > ls->d + m) continue;
+        if (length(across) * cos_t - along * sin_t > m) continue;
+        if (!light_cone_meets_box(o, axis, ls->d, sin_t / fmax(cos_t, 1e-6f), vload3(0, ob->lo),
+                                  vload3(0, ob->hi), m - b.w))
+            continue;
+        if (planar) {
+            float4 pl = vload4(0, ob->plane);
+            float e = ob->plane_eps + 1e-6f * reach;
+            float so = dot(pl.xyz, o) - pl.w, sl = dot(pl.xyz, c) - pl.w;
+            if ((so > e && sl - r > e) || (so < -e && sl + r < -e)) continue;
+        }
+        tris += ob->ntris + ob->ntex;
+        if (os->n == VB_OBJECT_SET_MAX || tris > VB_OBJECT_SET_MAX_TRIS) {
+            os->n = -1;
+            return;
+        }
+        os->obj[os->n++] = k;
+    }
 }
 
 /* Whether the BRDF gives direction w anything: a diffuse term, or w inside the specular
@@ -216,6 +324,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     float3 tx, ty;
     vb_frame(wc, &tx, &ty);
     CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
+    ObjectSet os;
+    light_cone_objects(scn, sp, ls, r, &os);
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
@@ -237,8 +347,14 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float b = dot(w, ls->to_c);
             float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
             float t_light = b - sqrt(disc);
-            sc->traced++;
-            float3 vis = light_feeler(scn, sp, ls->origin, w, t_light, tc);
+            float3 vis;
+            if (os.n == 0) {
+                sc->clear++;
+                vis = light_feeler_open(scn, sp, t_light);
+            } else {
+                sc->traced++;
+                vis = light_feeler(scn, sp, &os, ls->origin, w, t_light, tc);
+            }
             if (vb_max3(vis) <= 0.0f) continue;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
@@ -294,8 +410,16 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
 #ifdef VBCL_HAS_SPECULAR
     if (ls.specular && nh > ls.nh_min) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
 #endif
-    sc->traced++;
-    float3 vis = light_feeler(scn, sp, ls.origin, w, ls.d, tc);
+    float3 vis;
+    ObjectSet os;
+    light_cone_objects(scn, sp, &ls, 0.0f, &os);
+    if (os.n == 0) {
+        sc->clear++;
+        vis = light_feeler_open(scn, sp, ls.d);
+    } else {
+        sc->traced++;
+        vis = light_feeler(scn, sp, &os, ls.origin, w, ls.d, tc);
+    }
     if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
     return radiance * brdf * vis * (cos_n / ls.d2);
 }

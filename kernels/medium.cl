@@ -15,10 +15,10 @@
 VB_INLINE uint medium_material(const DevScene *sc, VbMedium m)
 {
     if (m.host < 0) return sc->f->air_material;
-    VbObject o = sc->objects[m.host];
-    if (o.tex_slot >= 0 && ((m.tex_counts >> (8u * (uint)o.tex_slot)) & 0xffu) != 0u)
-        return o.tex_material;
-    return o.material;
+    __global const VbObject *o = sc->objects + m.host;
+    if (o->tex_slot >= 0 && ((m.tex_counts >> (8u * (uint)o->tex_slot)) & 0xffu) != 0u)
+        return o->tex_material;
+    return o->material;
 }
 
 /* What crossing triangle `tri` along dir does to the medium. */
@@ -34,19 +34,19 @@ VB_INLINE Crossing medium_cross(const DevScene *sc, int tri, float3 dir, VbMediu
     Crossing c;
     uint tag = tri_tag(sc->tris, tri);
     uint obj = tag & ~VBCL_TAG_FLAGS;
-    VbObject o = sc->objects[obj];
+    __global const VbObject *o = sc->objects + obj;
     int entering = dot(tri_normal(sc->tris, tri), dir) < 0.0f; /* normals point outward */
     c.after = before;
     c.mat_before = medium_material(sc, before);
     if (tag & VBCL_TAG_TEXTURE) {
-        uint shift = 8u * (uint)o.tex_slot;
+        uint shift = 8u * (uint)o->tex_slot;
         uint k = (before.tex_counts >> shift) & 0xffu;
         k = entering ? min(k + 1u, 255u) : (k > 0u ? k - 1u : 0u);
         c.after.tex_counts = (before.tex_counts & ~(0xffu << shift)) | (k << shift);
-    } else if (o.flags & VBCL_OBJECT_HOST) {
+    } else if (o->flags & VBCL_OBJECT_HOST) {
         c.after.host = entering ? (int)obj : -1;
     } else { /* a surface that bounds no tracked volume: opaque */
-        c.mat_after = c.surface = o.material;
+        c.mat_after = c.surface = o->material;
         c.interface = 1;
         return c;
     }
@@ -152,16 +152,18 @@ VB_INLINE float3 medium_interface_transmit(const DevScene *sc, float3 d, float3 
 /* Light a shadow feeler of band `band` (-1: white) carries from the point to a light at
  * distance tmax, starting in medium `state`: multiplied by the transmitted fraction of
  * every interface it crosses (weighted by that surface's k_global) and by absorption along
- * the way; zero at an opaque surface. Feelers are not bent. */
-VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, float3 org, float3 dir, float tmax,
-                                             VbMedium state, int band, TraceCount *tc)
+ * the way; zero at an opaque surface. Feelers are not bent. Only the objects of os can be
+ * met (os->n < 0: any object, through the grid). */
+VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, const ObjectSet *os, float3 org,
+                                             float3 dir, float tmax, VbMedium state, int band,
+                                             TraceCount *tc)
 {
     float3 trans = (float3)(1.0f);
     float3 o = org;
     float left = tmax;
     for (int guard = 0; guard < 1024; guard++) {
         uint mb = medium_material(sc, state);
-        VbHit h = scene_trace_closest(sc, o, dir, left, tc);
+        VbHit h = scene_trace_closest_in(sc, os, o, dir, left, tc);
         if (h.tri < 0) return trans * medium_absorb(sc, mb, left);
         float3 p = tri_point(sc->tris, h);
         float seg = fmax(0.0f, dot(p - o, dir));

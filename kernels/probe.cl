@@ -68,9 +68,11 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.key = vb_hash((uint)i);
     sp.medium = f->camera_medium;
     sp.scale = 0.0f;
+    sp.object = -1;
+    sp.front = 0;
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
-    ShadowCount sc2 = {0, 0, 0};
+    ShadowCount sc2 = {0, 0, 0, 0};
     float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
     vstore4((float4)(col, (float)sc2.traced), i, radiance);
 }
@@ -87,6 +89,82 @@ __kernel void probe_optics(__global const float *in, int n, __global float *out)
     vstore4((float4)(s.reflected, s.R), 0, out + 12 * i);
     vstore4((float4)(s.transmitted, s.T), 0, out + 12 * i + 4);
     vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);
+}
+
+/* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
+ * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
+ * normal), a light (centre xyz, radius), the point's triangle's scale -> out: bits 0-1 what
+ * light_cone_objects says (0: the grid, 1: clear, 2: a set of objects alone; 3: the point
+ * is inside the light, no test), bits 2-15 how many of nrays feelers spread over the
+ * light's cap (uniform in solid angle, 8 on its rim; those leaving the surface's front
+ * only, each to the near side of the sphere) the brute force contradicts: for a clear cone,
+ * feelers that meet a triangle, every triangle tested; for a set, feelers whose closest hit
+ * among the set's objects (scene_trace_closest_in) is not the closest of all triangles
+ * (the same test, ties to the lower index), bits 16-31 such a feeler's triangle (clear) or
+ * its brute-force hit + 1 (set). */
+__kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
+                               __global uint *out)
+{
+    int i = get_global_id(0);
+    if (i >= ncases) return;
+    DevScene sc = DEV_SCENE;
+    __global const float *cs = cases + 16 * i;
+    ShadePoint sp;
+    sp.p = vload3(0, cs);
+    sp.object = (int)cs[3];
+    sp.ng = normalize(vload3(0, cs + 4));
+    sp.front = cs[7] > 0.0f;
+    sp.ns = sp.ng;
+    sp.wo = sp.ng;
+    sp.material = 0;
+    sp.key = 0;
+    sp.medium = f->camera_medium;
+    sp.scale = cs[12];
+    sp.band = -1;
+    float3 c = vload3(0, cs + 8);
+    float r = cs[11];
+    LightShading ls = light_shading_make(sc.materials, (float3)(0.0f), &sp, c);
+    if (ls.d <= r * 1.0001f) {
+        out[i] = 3u;
+        return;
+    }
+    ObjectSet os;
+    light_cone_objects(&sc, &sp, &ls, r, &os);
+    uint kind = os.n == 0 ? 1u : os.n > 0 ? 2u : 0u;
+    uint wrong = 0u, which = 0u;
+    if (kind != 0u) {
+        float3 wc = ls.to_c / ls.d, tx, ty;
+        vb_frame(wc, &tx, &ty);
+        float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
+        for (int k = 0; k < nrays; k++) {
+            uint h = vb_hash((uint)i * 7919u + (uint)k);
+            float u1 = k < 8 ? 1.0f : vb_unit_float(h); /* 8 feelers on the rim */
+            float u2 = vb_unit_float(vb_hash(h ^ 0x5bd1e995u));
+            float cos_t = 1.0f - u1 * one_minus_cos;
+            float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * VB_PI * u2;
+            float3 w = normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+            if (dot(sp.ng, w) <= 0.0f) continue;
+            float b = dot(w, ls.to_c);
+            float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
+            RayShear rs = ray_shear_make(ls.origin, w);
+            Closest all;
+            closest_begin(&all, t_light);
+            for (uint t = 0; t < f->ntris; t++)
+                closest_test(&rs, ls.origin, t_light, sc.tris, (int)t, &all);
+            int bad;
+            if (kind == 1u) {
+                bad = all.hit.tri >= 0;
+            } else {
+                TraceCount tc = {0, 0};
+                VbHit h = scene_trace_closest_in(&sc, &os, ls.origin, w, t_light, &tc);
+                bad = h.tri != all.hit.tri || (h.tri >= 0 && h.t != all.hit.t);
+            }
+            if (bad && !wrong) which = (uint)(all.hit.tri + (kind == 2u ? 1 : 0));
+            wrong += bad ? 1u : 0u;
+        }
+    }
+    out[i] = kind | min(wrong, 16383u) << 2 | which << 16;
 }
 
 /* The feelers' (u1, u2) of light_cap_uv (mode LIGHT_FEELERS_*) for keys key0 .. key0 +
@@ -235,8 +313,9 @@ __kernel void probe_hit_surface(SCENE_KERNEL_ARGS __global const VbRay *rays,
     surface[i] = probe_primary_point(&sc, rays, hits, media, i, &sp) ? (int)sp.material : -1;
 }
 
-/* points -> feelers traced (ShadowCount.traced) and radiance: the renderer's local shading
- * of each point with its shadow feelers, light_shade_local as light_sample_shading runs it. */
+/* points -> feelers decided (ShadowCount.traced + clear: traced, or not traced because
+ * their cone meets no object) and radiance: the renderer's local shading of each point
+ * with its shadow feelers, light_shade_local as light_sample_shading runs it. */
 __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
                                   __global const VbHit *hits, __global const VbMedium *media,
                                   __global const uint *points, int npoints, __global uint *traced,
@@ -248,10 +327,10 @@ __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
     ShadePoint sp;
     float3 col = (float3)(0.0f);
     TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0};
+    ShadowCount shc = {0, 0, 0, 0};
     if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
         col = light_shade_local(&sc, &sp, &tc, &shc);
-    traced[j] = shc.traced;
+    traced[j] = shc.traced + shc.clear; /* decided: traced, or clear by the cone test */
     vstore4((float4)(col, 0.0f), j, radiance);
 }
 

@@ -62,6 +62,63 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
                           org, dir, tmax, skip, tc);
 }
 
+/* A few objects, the only ones a ray may meet (the shadow cone test, light.cl, has shown
+ * the rest of the scene to be out of its way), or n < 0: any object (the grid). */
+#define VB_OBJECT_SET_MAX      2  /* objects */
+#define VB_OBJECT_SET_MAX_TRIS 32 /* triangles in all, textures included */
+typedef struct ObjectSet {
+    int n;
+    uint obj[VB_OBJECT_SET_MAX];
+} ObjectSet;
+
+/* The triangles of the set's object k: part 0 its own, part 1 its texture's. */
+VB_INLINE uint2 object_set_range(const DevScene *sc, const ObjectSet *os, int k, int part)
+{
+    __global const VbObject *ob = sc->objects + os->obj[k];
+    return part ? (uint2)(ob->first_tex, ob->ntex) : (uint2)(ob->first_tri, ob->ntris);
+}
+
+/* scene_trace_closest among the set's objects alone: each of their triangles tested (the
+ * same test and the same order of hits as the grid's, ties to the lower index), no walk. */
+VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, float3 org,
+                                       float3 dir, float tmax, TraceCount *tc)
+{
+    if (os->n < 0) return scene_trace_closest(sc, org, dir, tmax, tc);
+    Closest c;
+    closest_begin(&c, tmax);
+    RayShear rs = ray_shear_make(org, dir);
+    for (int k = 0; k < os->n; k++)
+        for (int part = 0; part < 2; part++) {
+            uint2 r = object_set_range(sc, os, k, part);
+            for (uint t = r.x; t < r.x + r.y; t++)
+                closest_test(&rs, org, tmax, sc->tris, (int)t, &c);
+            tc->tests += r.y;
+        }
+    return c.hit;
+}
+
+/* scene_trace_any among the set's objects alone. */
+VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+                                 float tmax, uint skip, TraceCount *tc)
+{
+    if (os->n < 0) return scene_trace_any(sc, org, dir, tmax, skip, tc);
+    RayShear rs = ray_shear_make(org, dir);
+    for (int k = 0; k < os->n; k++)
+        for (int part = 0; part < 2; part++) {
+            uint2 r = object_set_range(sc, os, k, part);
+            for (uint t = r.x; t < r.x + r.y; t++) {
+                if (skip != 0u && (tri_tag(sc->tris, (int)t) & skip) != 0u) continue;
+                float th, u, v;
+                tc->tests++;
+                if (tri_intersect(&rs, tri_vertex(sc->tris, (int)t, 0),
+                                  tri_vertex(sc->tris, (int)t, 1), tri_vertex(sc->tris, (int)t, 2),
+                                  tmax, &th, &u, &v))
+                    return 1;
+            }
+        }
+    return 0;
+}
+
 /* Material of an opaque-scene triangle: its object's own material. */
 VB_INLINE uint scene_tri_material(const DevScene *sc, int tri)
 {

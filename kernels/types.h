@@ -37,7 +37,9 @@
 #define VBCL_TAG_FLAGS   (VBCL_TAG_TEXTURE | VBCL_TAG_OPAQUE)
 
 /* VbObject.flags */
-#define VBCL_OBJECT_HOST 1u /* a closed volume whose inside the medium state tracks */
+#define VBCL_OBJECT_HOST   1u /* a closed volume whose inside the medium state tracks */
+#define VBCL_OBJECT_PLANAR 2u /* every triangle of the object lies in VbObject.plane */
+#define VBCL_OBJECT_CONVEX 4u /* every vertex lies behind (or on) every triangle's plane */
 
 /* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices
@@ -61,13 +63,14 @@
     X(ENERGY_ERRORS,   12, energy_errors,   ray_tree, "energy_errors")    /* |R+T-1| > 1e-5 */     \
     X(SPLITS,          13, splits,          ray_tree, "splits")           /* white -> bands */     \
     X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */     \
-    X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */
+    X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */  \
+    X(SHADOW_CLEAR,    16, shadow_clear,    rays,     "shadow_clear")     /* cone meets nothing */
 /* clang-format on */
 #define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
 enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
-#define VBCL_COUNT_DEPTH0     16 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH0     17 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS 16
-#define VBCL_COUNTERS         32
+#define VBCL_COUNTERS         33
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {
@@ -131,12 +134,25 @@ typedef struct VbPattern {
     VbFourier fourier; /* VBCL_PATTERN_FOURIER */
 } VbPattern;
 
-/* An object as the kernels see it: its material, and for a host its volume texture. */
+/* An object as the kernels see it: its material, for a host its volume texture, and
+ * where its triangles (texture included) lie, for the shadow cone test (light.cl). */
 typedef struct VbObject {
     unsigned int material;     /* the object's own volume and surface */
     unsigned int tex_material; /* its volume texture's material (when tex_slot >= 0) */
     int tex_slot;              /* which count of VbMedium.tex_counts, or -1: no texture */
     unsigned int flags;        /* VBCL_OBJECT_* */
+    float bound[4];            /* a sphere holding every triangle: centre, radius (margins
+                                * included; radius < 0: no triangles) */
+    float lo[3];               /* the triangles' bounding box, widened by the same margin */
+    float plane_eps;           /* the vertices' largest distance from the plane, plus a margin */
+    float hi[3];
+    unsigned int pad;
+    float plane[4];         /* VBCL_OBJECT_PLANAR: unit normal n and offset k (n.x = k on
+                             * the plane); w: k. Each vertex lies within plane_eps of it */
+    unsigned int first_tri; /* its own triangles: first_tri .. first_tri + ntris - 1 */
+    unsigned int ntris;
+    unsigned int first_tex; /* its texture's triangles */
+    unsigned int ntex;
 } VbObject;
 
 /* Where a ray is: inside which host (or none), and inside how many elements of each
@@ -227,11 +243,17 @@ typedef struct VbFrame {
     unsigned int band_weights; /* first float of the bands' rgb weights (4 floats each) in the
                                 * side data (texels) */
     unsigned int flags;        /* VBCL_FRAME_* */
+    unsigned int nobjects;     /* objects (VbObject), for the shadow cone test */
+    unsigned int pad[3];
 } VbFrame;
 
 /* VbFrame.flags */
 #define VBCL_FRAME_FIXED_FEELERS 1u /* shadow feelers at stratum centres, the same everywhere */
 #define VBCL_FRAME_NET_FEELERS   2u /* jittered feelers of a power-of-two side: a scrambled net */
+#define VBCL_FRAME_CONE_TEST                                                                       \
+    4u                                /* a point's feelers toward a light whose cone meets no      \
+                                       * object's bounds are not traced (light_cone_clear) */
+#define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
  * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
@@ -268,6 +290,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -275,7 +298,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -303,9 +326,18 @@ VBCL_STATIC_ASSERT(sizeof(VbGrid) == 80, grid_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGrid, n) == 64, grid_n);
 VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
-VBCL_STATIC_ASSERT(sizeof(VbObject) == 16, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 96, object_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, first_tri) == 80, object_first_tri);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ntex) == 92, object_ntex);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, bound) == 16, object_bound);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, lo) == 32, object_lo);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane_eps) == 44, object_plane_eps);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, hi) == 48, object_hi);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane) == 64, object_plane);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 240, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 256, frame_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, flags) == 236, frame_flags);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, nobjects) == 240, frame_nobjects);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, max_depth) == 224, frame_max_depth);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, camera_medium) == 208, frame_camera_medium);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, min_weight) == 220, frame_min_weight);

@@ -292,6 +292,57 @@ static void test_cli_fixed_feelers(void)
     for (int k = 0; k < 4; k++) free(img[k]);
 }
 
+/* The shadow cone test (light.cl, light_cone_clear) leaves feelers untraced only where
+ * tracing them finds nothing: on scenes with planar, convex, textured, transparent and
+ * dispersive objects, the image is bit-identical to --no-cone-test's, which traces every
+ * feeler, and the feelers it did not trace are exactly the ones missing from the count. */
+static void test_cli_cone_test(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const char *const scenes[] = {
+        "scenes/quickstart.json",           "scenes/glass_bombed_sphere.json",
+        "scenes/thesis/a4_two_prisms.json", "scenes/bench/spheres36.json",
+        "scenes/thesis/a5_dispersion.json", "scenes/thesis/a2_marble.json"};
+    for (size_t n = 0; n < sizeof scenes / sizeof *scenes; n++) {
+        float *img[2] = {NULL, NULL};
+        double shadow[2] = {0, 0}, clear[2] = {0, 0};
+        int w = 0, h = 0;
+        for (int k = 0; k < 2; k++) {
+            char out[8192], args[2048], path[512], json[512], err[512];
+            snprintf(path, sizeof path, "%s/cone%d.exr", tu_tmpdir(), k);
+            snprintf(json, sizeof json, "%s/cone%d.json", tu_tmpdir(), k);
+            snprintf(args, sizeof args,
+                     "%s -q --width 40 --height 40 --aa 0 --shadow-samples 4 -o %s "
+                     "--stats-json %s%s",
+                     scenes[n], path, json, k ? " --no-cone-test" : "");
+            CHECK(vbcl(args, out, sizeof out) == 0, "%s: %s", args, out);
+            if (image_read(path, &w, &h, &img[k], err, sizeof err)) CHECK(0, "%s", err);
+            cJSON *doc = read_json(json);
+            shadow[k] = json_num(doc, "rays", "shadow", NULL);
+            clear[k] = json_num(doc, "rays", "shadow_clear", NULL);
+            cJSON_Delete(doc);
+        }
+        if (img[0] && img[1]) {
+            double diff = 0;
+            for (int i = 0; i < w * h * 4; i++) diff = fmax(diff, fabs(img[0][i] - img[1][i]));
+            CHECK(diff == 0.0, "%s: the cone test changes the image by up to %g", scenes[n], diff);
+        }
+        CHECK(clear[1] == 0 && clear[0] > 0,
+              "%s: feelers left untraced with and without the "
+              "cone test: %g, %g",
+              scenes[n], clear[0], clear[1]);
+        CHECK(shadow[0] + clear[0] == shadow[1],
+              "%s: %g traced + %g clear != %g traced "
+              "without the test",
+              scenes[n], shadow[0], clear[0], shadow[1]);
+        free(img[0]);
+        free(img[1]);
+    }
+}
+
 static void test_cli_bad_input_classes(void)
 {
     expect_bad("{\"camera\": ", NULL, "bad.json:1:"); /* malformed JSON */
@@ -568,5 +619,6 @@ void suite_cli(void)
     RUN_TEST(test_cli_mesh_files_capped);
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
+    RUN_TEST(test_cli_cone_test);
     RUN_TEST(test_cli_stats_json);
 }

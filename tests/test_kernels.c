@@ -442,6 +442,163 @@ static void test_light_irradiance_closed_form(void)
     fixture_close(&fx);
 }
 
+/* The shadow cone test (light_cone_clear) against brute force: points on every kind of
+ * surface (a floor and a tilted wall: planar; a box, a prism, a sphere: convex; a vase:
+ * neither; a glass sphere with a texture of bombed spheres), on either side, under lights
+ * of random places and sizes. Wherever the test says the cone is clear, none of 128
+ * feelers per point over the light's cap (its rim included), each tested against every
+ * triangle, may meet one; over a million such feelers. The test must also find clear
+ * cones, planar and convex surfaces' own included. Where it names a few objects as the
+ * only ones in the way, the closest hit among them is every feeler's closest hit of all. */
+static void test_light_cone_brute(void)
+{
+    Fixture fx;
+    if (fixture_open(
+            &fx,
+            "{" CAM "\"materials\": {\"m\": {}, \"g\": {\"k_local\": 0.1, "
+            "\"k_global\": 0.9, \"eta\": 1.5}, \"e\": {\"diffuse\": [1, 0, 0]}},"
+            " \"objects\": ["
+            "{\"shape\": \"quad\", \"size\": [10, 10], \"material\": \"m\"},"
+            "{\"shape\": \"quad\", \"size\": [6, 3], \"material\": \"m\","
+            " \"transform\": {\"rotate\": [70, 20, 0], \"translate\": [0, 2, -3]}},"
+            "{\"shape\": \"box\", \"size\": [1, 2, 0.5], \"material\": \"m\","
+            " \"transform\": {\"rotate\": [10, 30, 5], \"translate\": [-2, 1, 0]}},"
+            "{\"shape\": \"prism\", \"material\": \"m\","
+            " \"transform\": {\"translate\": [2, 0.5, 1]}},"
+            "{\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.6, \"centre\": [0, 2.5, 1],"
+            " \"material\": \"m\"},"
+            "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","
+            " \"profile\": [[0.5, 0], [0.2, 0.6], [0.6, 1.2], [0.3, 1.6]],"
+            " \"transform\": {\"translate\": [0.5, 0, -1]}},"
+            "{\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.8, \"centre\": [-0.5, 0.8, 2],"
+            " \"material\": \"g\", \"texture\": {\"generate\": \"bomb --shape sphere "
+            "--count 6 --size 20:30 --seed 3\", \"material\": \"e\"}}]}"))
+        return;
+    enum { CASES = 16384, RAYS = 128 };
+    const Mesh *m = &fx.s.mesh;
+    float *cases = calloc((size_t)CASES * 16, sizeof(float));
+    unsigned *out = calloc(CASES, sizeof(unsigned));
+    unsigned seed = 99;
+    for (int i = 0; i < CASES && cases; i++) {
+        float *c = cases + 16 * i;
+        /* an object at random, then one of its triangles (or of its texture's) */
+        const SceneObject *ob =
+            &fx.s.objects[(int)(frand(&seed) * (float)fx.s.nobjects) % fx.s.nobjects];
+        int tex = ob->ntex_tris > 0 && frand(&seed) < 0.5f;
+        uint32_t t = tex ? ob->first_tex_tri +
+                               (uint32_t)(frand(&seed) * (float)ob->ntex_tris) % ob->ntex_tris
+                         : ob->first_tri + (uint32_t)(frand(&seed) * (float)ob->ntris) % ob->ntris;
+        vec3 a = m->verts[m->tris[3 * t]], b = m->verts[m->tris[3 * t + 1]],
+             d = m->verts[m->tris[3 * t + 2]];
+        float u = frand(&seed), v = frand(&seed);
+        if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
+        vec3 e1 = v3_sub(b, a), e2 = v3_sub(d, a);
+        vec3 p = v3_add(a, v3_add(v3_scale(e1, u), v3_scale(e2, v)));
+        float side = frand(&seed) < 0.5f ? 1.0f : -1.0f;
+        vec3 n = v3_scale(v3_norm(v3_cross(e1, e2)), side);
+        uint32_t tag = fx.s.tri_tag[t];
+        float scale = 0.0f;
+        vec3 vs[3] = {a, b, d};
+        for (int k = 0; k < 3; k++)
+            scale = fmaxf(scale, fmaxf(fabsf(vs[k].x), fmaxf(fabsf(vs[k].y), fabsf(vs[k].z))));
+        float pv[16] = {p.x,
+                        p.y,
+                        p.z,
+                        (tag & VBCL_TAG_TEXTURE) ? -1.0f : (float)(tag & ~VBCL_TAG_FLAGS),
+                        n.x,
+                        n.y,
+                        n.z,
+                        side,
+                        16.0f * frand(&seed) - 8.0f,
+                        8.0f * frand(&seed) + 2.0f,
+                        16.0f * frand(&seed) - 8.0f,
+                        frand(&seed) * frand(&seed),
+                        scale,
+                        0,
+                        0,
+                        0};
+        memcpy(c, pv, sizeof pv);
+    }
+    cl_mem mc = buffer(cases, sizeof(float) * 16 * CASES),
+           mo = buffer(NULL, sizeof(unsigned) * CASES);
+    int ncases = CASES, nrays = RAYS;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(int), sizeof(cl_mem)};
+    const void *vals[] = {&mc, &ncases, &nrays, &mo};
+    fixture_run_probe(&fx, "probe_cone_brute", CASES, 4, sz, vals);
+    read_buffer(mo, out, sizeof(unsigned) * CASES);
+    long count[4] = {0, 0, 0, 0}, wrong[4] = {0, 0, 0, 0}, own_clear = 0;
+    for (int i = 0; i < CASES; i++) {
+        unsigned kind = out[i] & 3u, nb = (out[i] >> 2) & 16383u;
+        count[kind]++;
+        wrong[kind] += nb != 0;
+        int obj = (int)cases[16 * i + 3];
+        own_clear += kind == 1 && obj >= 0 && obj <= 4; /* the planar and convex ones */
+        if (nb && wrong[kind] <= 3) {
+            const float *c = cases + 16 * i;
+            fprintf(stderr,
+                    "    %s cone wrong: point (%g %g %g) on object %g, normal (%g %g %g) side %g, "
+                    "light (%g %g %g) r %g: %u feelers, one with triangle %u\n",
+                    kind == 1 ? "clear" : "object set", c[0], c[1], c[2], c[3], c[4], c[5], c[6],
+                    c[7], c[8], c[9], c[10], c[11], nb, out[i] >> 16);
+        }
+    }
+    fprintf(stderr,
+            "    %u triangles, %d points: %ld clear cones (%ld on planar or convex objects, "
+            "their own surface left out), %ld a set of objects alone, %ld the grid, %ld inside "
+            "a light; %ld feelers against brute force\n",
+            m->ntris, CASES, count[1], own_clear, count[2], count[0], count[3],
+            (count[1] + count[2]) * RAYS);
+    CHECK(wrong[1] == 0, "%ld clear cones have feelers that meet a triangle", wrong[1]);
+    CHECK(wrong[2] == 0, "%ld cones' object sets miss a feeler's closest hit", wrong[2]);
+    CHECK((count[1] + count[2]) * RAYS >= 1000000 && own_clear > count[1] / 4 &&
+              count[2] > CASES / 20,
+          "too few cones to test: %ld clear (%ld on planar or convex objects), %ld sets", count[1],
+          own_clear, count[2]);
+    clReleaseMemObject(mc);
+    clReleaseMemObject(mo);
+    free(cases);
+    free(out);
+    fixture_close(&fx);
+}
+
+/* The host sets the cone test (VBCL_FRAME_CONE_TEST) by default, not with
+ * "shadow_cone_test": false, nor for a scene of more than VBCL_CONE_TEST_MAX_OBJECTS
+ * objects; a bad value of the key is refused. */
+static void test_light_cone_flag(void)
+{
+    static char json[16384];
+    for (int k = 0; k < 3; k++) {
+        int n = snprintf(json, sizeof json,
+                         "{" CAM "\"render\": {%s}, \"materials\": {\"m\": {}}, "
+                         "\"objects\": [",
+                         k == 1 ? "\"shadow_cone_test\": false" : "");
+        int nobj = k == 2 ? VBCL_CONE_TEST_MAX_OBJECTS + 1 : 2;
+        for (int i = 0; i < nobj; i++)
+            n += snprintf(json + n, sizeof json - (size_t)n,
+                          "%s{\"shape\": \"box\", \"size\": [0.1, 0.1, 0.1], \"material\": \"m\", "
+                          "\"transform\": {\"translate\": [%d, 0, 0]}}",
+                          i ? ", " : "", i);
+        snprintf(json + n, sizeof json - (size_t)n, "]}");
+        Fixture fx;
+        if (fixture_open(&fx, json)) return;
+        unsigned want = k == 0 ? VBCL_FRAME_CONE_TEST : 0u;
+        CHECK((fx.r.frame_host.flags & VBCL_FRAME_CONE_TEST) == want &&
+                  fx.r.frame_host.nobjects == (unsigned)nobj,
+              "case %d (%d objects): frame flags %u, %u objects", k, nobj, fx.r.frame_host.flags,
+              fx.r.frame_host.nobjects);
+        fixture_close(&fx);
+    }
+    Scene s;
+    char err[512];
+    const char *path = tu_write_file(
+        "cone_flag.json", "{" CAM "\"render\": {\"shadow_cone_test\": 1}, "
+                          "\"materials\": {\"m\": {}}, \"objects\": [{\"shape\": \"box\", "
+                          "\"material\": \"m\"}]}");
+    CHECK(scene_load(path, &s, err, sizeof err) != 0 && strstr(err, "render.shadow_cone_test") &&
+              strstr(err, "expected true or false"),
+          "shadow_cone_test 1: %s", err);
+}
+
 /* Runs probe_cap_uv (mode LIGHT_FEELERS_*: 0 fixed, 1 jittered, 2 net): nkeys x strata^2
  * (u1, u2) pairs into uv. Returns 0 or -1. */
 static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int mode, float *uv)
@@ -519,8 +676,9 @@ static void test_light_feelers_net(void)
         CHECK(bad == 0, "9 feelers, jitter %d: %d outside their squares or off centre", jitter,
               bad);
     }
-    CHECK(fx.r.frame_host.flags == VBCL_FRAME_NET_FEELERS, "16 feelers: frame flags %u",
-          fx.r.frame_host.flags);
+    const unsigned placement = VBCL_FRAME_NET_FEELERS | VBCL_FRAME_FIXED_FEELERS;
+    CHECK((fx.r.frame_host.flags & placement) == VBCL_FRAME_NET_FEELERS,
+          "16 feelers: frame flags %u", fx.r.frame_host.flags);
     fixture_close(&fx);
     const char *other[2] = {"\"shadow_samples\": 9", "\"shadow_jitter\": false"};
     const unsigned want[2] = {0u, VBCL_FRAME_FIXED_FEELERS};
@@ -531,8 +689,8 @@ static void test_light_feelers_net(void)
                  "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}",
                  other[k]);
         if (fixture_open(&fx, json)) return;
-        CHECK(fx.r.frame_host.flags == want[k], "%s: frame flags %u, want %u", other[k],
-              fx.r.frame_host.flags, want[k]);
+        CHECK((fx.r.frame_host.flags & placement) == want[k], "%s: frame flags %u, want %u",
+              other[k], fx.r.frame_host.flags, want[k]);
         fixture_close(&fx);
     }
 }
@@ -643,5 +801,7 @@ void suite_kernels(void)
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
     RUN_TEST(test_light_feelers_net);
+    RUN_TEST(test_light_cone_brute);
+    RUN_TEST(test_light_cone_flag);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
 }

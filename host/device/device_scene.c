@@ -249,6 +249,118 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
     return 1;
 }
 
+/* Accumulates the vertices of triangles first .. first + n - 1 of m into a bounding box
+ * (double precision). */
+static void object_box(const Mesh *m, uint32_t first, uint32_t n, double lo[3], double hi[3])
+{
+    for (uint32_t t = first; t < first + n; t++)
+        for (int k = 0; k < 3; k++) {
+            vec3 v = m->verts[m->tris[3 * t + k]];
+            double c[3] = {v.x, v.y, v.z};
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], c[a]);
+                hi[a] = fmax(hi[a], c[a]);
+            }
+        }
+}
+
+/* The largest distance of a vertex of triangles first .. first + n - 1 from the point c
+ * (*r) and from the plane n.x = k (*dev). */
+static void object_spread(const Mesh *m, uint32_t first, uint32_t n, const double c[3],
+                          const double nrm[3], double k, double *r, double *dev)
+{
+    for (uint32_t t = first; t < first + n; t++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = m->verts[m->tris[3 * t + j]];
+            double d[3] = {v.x - c[0], v.y - c[1], v.z - c[2]};
+            *r = fmax(*r, sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+            *dev = fmax(*dev, fabs(nrm[0] * v.x + nrm[1] * v.y + nrm[2] * v.z - k));
+        }
+}
+
+/* Whether every vertex of triangles first .. first + n - 1 of m and of the texture's
+ * tex_first .. tex_first + tex_n - 1 lies behind (or within eps of) the plane of each of
+ * the first ones (counter-clockwise seen from the front): a convex surface with its
+ * texture inside. Tested for at most 2048 triangles, texture included (the test is
+ * quadratic); larger objects count as not convex, as do degenerate triangles. */
+static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex_first,
+                         uint32_t tex_n, double eps)
+{
+    if (n == 0 || (uint64_t)n + tex_n > 2048) return 0;
+    for (uint32_t t = first; t < first + n; t++) {
+        vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
+             p2 = m->verts[m->tris[3 * t + 2]];
+        double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+        double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
+        double x[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        if (!(len > 0.0)) return 0;
+        for (uint32_t q = 0; q < n + tex_n; q++)
+            for (int j = 0; j < 3; j++) {
+                uint32_t u = q < n ? first + q : tex_first + (q - n);
+                vec3 v = m->verts[m->tris[3 * u + j]];
+                double h = (x[0] * (v.x - p0.x) + x[1] * (v.y - p0.y) + x[2] * (v.z - p0.z)) / len;
+                if (h > eps) return 0;
+            }
+    }
+    return 1;
+}
+
+/* Where object o's triangles (its texture's included) lie, for the shadow cone test
+ * (light.cl, light_cone_clear): a sphere and a box holding them all, and for an object whose
+ * vertices lie within 1e-6 of its size of one plane (a floor, a wall: any planar mesh),
+ * that plane. Computed in double precision from the float vertices the kernels use, and
+ * widened by margins far above float rounding, so the tests that use them stay
+ * conservative. */
+static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    object_box(m, o->first_tri, o->ntris, lo, hi);
+    object_box(m, o->first_tex_tri, o->ntex_tris, lo, hi);
+    g->bound[3] = -1.0f; /* no triangles: nothing to meet */
+    if (!(lo[0] <= hi[0])) return;
+    double c[3], mag = 0.0;
+    for (int a = 0; a < 3; a++) {
+        c[a] = 0.5 * (lo[a] + hi[a]);
+        mag = fmax(mag, fmax(fabs(lo[a]), fabs(hi[a])));
+    }
+    /* the plane of the object's largest triangle */
+    double nrm[3] = {0, 0, 0}, best = 0.0, k = 0.0;
+    for (uint32_t t = o->first_tri; t < o->first_tri + o->ntris; t++) {
+        vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
+             p2 = m->verts[m->tris[3 * t + 2]];
+        double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+        double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
+        double x[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        if (len > best) {
+            best = len;
+            for (int a = 0; a < 3; a++) nrm[a] = x[a] / len;
+            k = nrm[0] * p0.x + nrm[1] * p0.y + nrm[2] * p0.z;
+        }
+    }
+    double r = 0.0, dev = 0.0;
+    object_spread(m, o->first_tri, o->ntris, c, nrm, k, &r, &dev);
+    object_spread(m, o->first_tex_tri, o->ntex_tris, c, nrm, k, &r, &dev);
+    double margin = 1e-5 * (mag + r);
+    for (int a = 0; a < 3; a++) {
+        g->bound[a] = (float)c[a];
+        g->lo[a] = (float)(lo[a] - margin);
+        g->hi[a] = (float)(hi[a] + margin);
+    }
+    g->bound[3] = (float)(r + margin);
+    if (object_convex(m, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris, 1e-6 * (mag + r)))
+        g->flags |= VBCL_OBJECT_CONVEX;
+    if (best > 0.0 && dev <= 1e-6 * r) {
+        g->flags |= VBCL_OBJECT_PLANAR;
+        for (int a = 0; a < 3; a++) g->plane[a] = (float)nrm[a];
+        g->plane[3] = (float)k;
+        g->plane_eps = (float)(dev + margin);
+    }
+}
+
 /* Materials (the scene's, then the medium outside every host: vacuum, eta 1), their
  * patterns and band tables, objects and lights. Returns as upload_patterns. */
 static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsigned features,
@@ -272,6 +384,11 @@ static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsi
         objs[i].tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
         objs[i].tex_slot = o->tex_slot;
         objs[i].flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
+        object_bounds(&s->mesh, o, &objs[i]);
+        objs[i].first_tri = o->first_tri;
+        objs[i].ntris = o->ntris;
+        objs[i].first_tex = o->first_tex_tri;
+        objs[i].ntex = o->ntex_tris;
     }
     b->materials =
         clu_buffer(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
@@ -306,6 +423,9 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     f->flags = !s->shadow_jitter                             ? VBCL_FRAME_FIXED_FEELERS
                : (f->shadow_strata & (f->shadow_strata - 1)) ? 0u
                                                              : VBCL_FRAME_NET_FEELERS;
+    if (s->shadow_cone_test && s->nobjects <= VBCL_CONE_TEST_MAX_OBJECTS)
+        f->flags |= VBCL_FRAME_CONE_TEST;
+    f->nobjects = (unsigned)s->nobjects;
     scene_medium_at(s, s->eye, &f->camera_medium);
     f->air_material = (unsigned)s->nmaterials;
     f->min_weight = s->min_weight;

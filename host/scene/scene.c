@@ -222,14 +222,40 @@ static int get_aa(Ctx *c, const cJSON *j, Scene *s)
                           &s->aa_level_gain);
 }
 
+/* render.<key>, when present: true or false into *v. */
+static int get_bool(Ctx *c, const cJSON *j, const char *key, int *v)
+{
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, key);
+    if (!b) return 0;
+    if (!cJSON_IsBool(b)) {
+        char path[64];
+        snprintf(path, sizeof path, "render.%s", key);
+        return scene_fail(c, path, "expected true or false, got %s", json_type_name(b));
+    }
+    *v = cJSON_IsTrue(b);
+    return 0;
+}
+
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {
-        "max_depth", "grid",          "grid_density", "shadow_samples",
-        "ambient",   "seed",          "fresnel",      "min_weight",
-        "aa",        "aa_max_level",  "aa_floor",     "aa_level_gain",
-        "bands",     "shadow_jitter", "subgrid",      "subgrid_density",
-        NULL};
+    static const char *const keys[] = {"max_depth",
+                                       "grid",
+                                       "grid_density",
+                                       "shadow_samples",
+                                       "ambient",
+                                       "seed",
+                                       "fresnel",
+                                       "min_weight",
+                                       "aa",
+                                       "aa_max_level",
+                                       "aa_floor",
+                                       "aa_level_gain",
+                                       "bands",
+                                       "shadow_jitter",
+                                       "subgrid",
+                                       "subgrid_density",
+                                       "shadow_cone_test",
+                                       NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
     s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
@@ -247,6 +273,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
     s->shadow_jitter = 1;
+    s->shadow_cone_test = 1;
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -261,13 +288,9 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_aa(c, j, s) || get_bands(c, j, s))
         return -1;
     s->seed = (unsigned)seed;
-    const cJSON *jit = cJSON_GetObjectItemCaseSensitive(j, "shadow_jitter");
-    if (jit) {
-        if (!cJSON_IsBool(jit))
-            return scene_fail(c, "render.shadow_jitter", "expected true or false, got %s",
-                              json_type_name(jit));
-        s->shadow_jitter = cJSON_IsTrue(jit);
-    }
+    if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
+        get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test))
+        return -1;
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
     if (fr) {
         if (cJSON_IsString(fr) && strcmp(fr->valuestring, "exact") == 0)

@@ -73,20 +73,21 @@ typedef struct Scene {
     int shadow_samples; /* as given; the kernels use the nearest square */
     float ambient[3];
     unsigned seed;
-    int shadow_jitter;   /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
-    int fresnel;         /* SCENE_FRESNEL_* */
-    float min_weight;    /* ray-tree pruning threshold */
-    float aa_threshold;  /* adaptive anti-aliasing contrast threshold; 0: off */
-    int aa_max_level;    /* deepest refinement level: 2^level x 2^level samples (1..4) */
-    float aa_floor;      /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
-    float aa_level_gain; /* a leaf at level L fails at aa_threshold * gain^L (1: the thesis) */
-    int ssaa;            /* uniform N x N supersampling (command line only); 1: off */
-    int bands;           /* render.bands: wavelength bands of a dispersive split */
-    int band_layout;     /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
-                          * dispersive material uses the thesis model */
-    int frames;          /* animation.frames, or 1 */
-    int animated;        /* the scene has an "animation" */
-    int frame;           /* the frame loaded (0 for a scene as written) */
+    int shadow_jitter;    /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
+    int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_clear) */
+    int fresnel;          /* SCENE_FRESNEL_* */
+    float min_weight;     /* ray-tree pruning threshold */
+    float aa_threshold;   /* adaptive anti-aliasing contrast threshold; 0: off */
+    int aa_max_level;     /* deepest refinement level: 2^level x 2^level samples (1..4) */
+    float aa_floor;       /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
+    float aa_level_gain;  /* a leaf at level L fails at aa_threshold * gain^L (1: the thesis) */
+    int ssaa;             /* uniform N x N supersampling (command line only); 1: off */
+    int bands;            /* render.bands: wavelength bands of a dispersive split */
+    int band_layout;      /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
+                           * dispersive material uses the thesis model */
+    int frames;           /* animation.frames, or 1 */
+    int animated;         /* the scene has an "animation" */
+    int frame;            /* the frame loaded (0 for a scene as written) */
     /* contents */
     int nlights;
     VbLight *lights;

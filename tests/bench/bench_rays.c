@@ -28,7 +28,7 @@
 
 typedef struct Options {
     const char *scene, *grid, *device, *json;
-    int width, height, shadow_samples, repeats, threads, robust;
+    int width, height, shadow_samples, repeats, threads, robust, no_cone_test;
 } Options;
 
 enum { KIND_PRIMARY, KIND_SHADOW, KIND_GLASS, KIND_SECONDARY, KIND_COUNT };
@@ -74,6 +74,9 @@ static const char usage[] =
     "  --grid auto|N|X,Y,Z     the renderer's grid (default: the scene's own)\n"
     "  --width N --height N    camera rays (default: the scene's image size)\n"
     "  --shadow-samples N      feelers per point and light (default: the scene's)\n"
+    "  --no-cone-test          vbcl traces every feeler (by default, as in a render, the\n"
+    "                          feelers whose cone to the light meets no object are not\n"
+    "                          traced; the shadow kinds count them all the same)\n"
     "  --repeats N             timed repeats after one warm-up (default 5, at most 64)\n"
     "  --threads N             Embree's threads (default 2)\n"
     "  --embree-robust 0|1     RTC_SCENE_FLAG_ROBUST (default 1)\n"
@@ -111,6 +114,8 @@ static int parse_args(int argc, char **argv, Options *o)
             o->grid = argv[++i];
         else if (!strcmp(a, "--device") && v)
             o->device = argv[++i];
+        else if (!strcmp(a, "--no-cone-test"))
+            o->no_cone_test = 1;
         else if (!strcmp(a, "--json") && v)
             o->json = argv[++i];
         else if (!strcmp(a, "--width"))
@@ -794,6 +799,7 @@ static int bench_open(Bench *b)
     if (o->width) b->s.width = o->width;
     if (o->height) b->s.height = o->height;
     if (o->shadow_samples) b->s.shadow_samples = o->shadow_samples;
+    if (o->no_cone_test) b->s.shadow_cone_test = 0;
     if (o->grid && scene_parse_grid(o->grid, b->s.grid_res)) {
         fprintf(stderr, "vbcl-bench-rays: --grid %s: expected auto, N or NX,NY,NZ\n", o->grid);
         scene_free(&b->s);
