@@ -252,7 +252,7 @@ typedef struct VbFrame {
 #define VBCL_FRAME_NET_FEELERS   2u /* jittered feelers of a power-of-two side: a scrambled net */
 #define VBCL_FRAME_CONE_TEST                                                                       \
     4u                                /* a point's feelers toward a light whose cone meets no      \
-                                       * object's bounds are not traced (light_cone_clear) */
+                                       * object's bounds are not traced (light_cone_objects) */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and

@@ -292,7 +292,7 @@ static void test_cli_fixed_feelers(void)
     for (int k = 0; k < 4; k++) free(img[k]);
 }
 
-/* The shadow cone test (light.cl, light_cone_clear) leaves feelers untraced only where
+/* The shadow cone test (light.cl, light_cone_objects) leaves feelers untraced only where
  * tracing them finds nothing: on scenes with planar, convex, textured, transparent and
  * dispersive objects, the image is bit-identical to --no-cone-test's, which traces every
  * feeler, and the feelers it did not trace are exactly the ones missing from the count. */

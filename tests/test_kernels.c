@@ -442,7 +442,7 @@ static void test_light_irradiance_closed_form(void)
     fixture_close(&fx);
 }
 
-/* The shadow cone test (light_cone_clear) against brute force: points on every kind of
+/* The shadow cone test (light_cone_objects) against brute force: points on every kind of
  * surface (a floor and a tilted wall: planar; a box, a prism, a sphere: convex; a vase:
  * neither; a glass sphere with a texture of bombed spheres), on either side, under lights
  * of random places and sizes. Wherever the test says the cone is clear, none of 128

@@ -278,6 +278,20 @@ static void object_spread(const Mesh *m, uint32_t first, uint32_t n, const doubl
         }
 }
 
+/* The unnormalised normal of triangle t of m, (v1 - v0) x (v2 - v0) in double precision,
+ * into x; returns v0. */
+static vec3 tri_normal_d(const Mesh *m, uint32_t t, double x[3])
+{
+    vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
+         p2 = m->verts[m->tris[3 * t + 2]];
+    double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+    double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
+    x[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    x[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    x[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    return p0;
+}
+
 /* Whether every vertex of triangles first .. first + n - 1 of m and of the texture's
  * tex_first .. tex_first + tex_n - 1 lies behind (or within eps of) the plane of each of
  * the first ones (counter-clockwise seen from the front): a convex surface with its
@@ -288,12 +302,8 @@ static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex
 {
     if (n == 0 || (uint64_t)n + tex_n > 2048) return 0;
     for (uint32_t t = first; t < first + n; t++) {
-        vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
-             p2 = m->verts[m->tris[3 * t + 2]];
-        double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
-        double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
-        double x[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double x[3];
+        vec3 p0 = tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         if (!(len > 0.0)) return 0;
         for (uint32_t q = 0; q < n + tex_n; q++)
@@ -308,7 +318,7 @@ static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex
 }
 
 /* Where object o's triangles (its texture's included) lie, for the shadow cone test
- * (light.cl, light_cone_clear): a sphere and a box holding them all, and for an object whose
+ * (light.cl, light_cone_objects): a sphere and a box holding them all, and for an object whose
  * vertices lie within 1e-6 of its size of one plane (a floor, a wall: any planar mesh),
  * that plane. Computed in double precision from the float vertices the kernels use, and
  * widened by margins far above float rounding, so the tests that use them stay
@@ -328,12 +338,8 @@ static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
     /* the plane of the object's largest triangle */
     double nrm[3] = {0, 0, 0}, best = 0.0, k = 0.0;
     for (uint32_t t = o->first_tri; t < o->first_tri + o->ntris; t++) {
-        vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
-             p2 = m->verts[m->tris[3 * t + 2]];
-        double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
-        double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
-        double x[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double x[3];
+        vec3 p0 = tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         if (len > best) {
             best = len;

@@ -74,7 +74,7 @@ typedef struct Scene {
     float ambient[3];
     unsigned seed;
     int shadow_jitter;    /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
-    int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_clear) */
+    int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_objects) */
     int fresnel;          /* SCENE_FRESNEL_* */
     float min_weight;     /* ray-tree pruning threshold */
     float aa_threshold;   /* adaptive anti-aliasing contrast threshold; 0: off */
