@@ -177,6 +177,18 @@ VB_INLINE void closest_test(const RayShear *rs, float3 org, float tmax,
     }
 }
 
+/* Whether triangle tri lies on the ray before tmax (not when its tag has a bit of `skip`,
+ * VBCL_TAG_TEXTURE or 0); counts the test in *tests. */
+VB_INLINE int any_test(const RayShear *rs, float tmax, __global const VbTriangle *tris, int tri,
+                       uint skip, uint *tests)
+{
+    if (skip != 0u && (tri_tag(tris, tri) & skip) != 0u) return 0;
+    float t, u, v;
+    (*tests)++;
+    return tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                         tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
+}
+
 /* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
  * updating *c. Returns the number of tests. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
@@ -240,12 +252,7 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
     uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
     int blocked = 0;
     for (uint k = begin; k < end && !blocked; k++) {
-        int tri = (int)leaf_tris[k];
-        if (skip != 0u && (tri_tag(tris, tri) & skip) != 0u) continue;
-        float t, u, v;
-        (*tests)++;
-        blocked = tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                                tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
+        blocked = any_test(rs, tmax, tris, (int)leaf_tris[k], skip, tests);
     }
     return blocked;
 }

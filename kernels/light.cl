@@ -71,7 +71,7 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, const Ob
 VB_INLINE float3 light_feeler_open(const DevScene *sc, const ShadePoint *sp, float t)
 {
 #ifdef VBCL_HAS_TRANSPARENCY
-    return (float3)(1.0f) * medium_absorb(sc, medium_material(sc, sp->medium), t);
+    return medium_absorb(sc, medium_material(sc, sp->medium), t); /* 1 * x is x */
 #else
     (void)sc;
     (void)sp;
@@ -201,10 +201,10 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
         if (b.w < 0.0f) continue;
         float3 v = b.xyz - o;
         float along = dot(v, axis);
-        float3 across = v - along * axis;
-        float m = b.w + 1e-5f * (ls->d + fabs(along) + length(across) + b.w);
+        float perp = length(v - along * axis);
+        float m = b.w + 1e-5f * (ls->d + fabs(along) + perp + b.w);
         if (along < -m || along > ls->d + m) continue;
-        if (length(across) * cos_t - along * sin_t > m) continue;
+        if (perp * cos_t - along * sin_t > m) continue;
         if (!light_cone_meets_box(o, axis, ls->d, sin_t / fmax(cos_t, 1e-6f), vload3(0, ob->lo),
                                   vload3(0, ob->hi), m - b.w))
             continue;
@@ -290,19 +290,23 @@ VB_INLINE float2 light_cap_uv(const CapFeelers *cf, uint i, uint j)
                     ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata);
 }
 
+/* The direction at (u1, u2) of the unit square on the cap of half-angle theta_max around
+ * wc (frame tx, ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle, u1 the
+ * cosine's share (1: the rim) and u2 the turn. */
+VB_INLINE float3 light_cap_at(float2 u, float one_minus_cos, float3 tx, float3 ty, float3 wc)
+{
+    float cos_t = 1.0f - u.x * one_minus_cos;
+    float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
+    float phi = 2.0f * VB_PI * u.y;
+    return normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+}
+
 #ifdef VBCL_HAS_AREA_LIGHTS
-/* The direction of feeler (i, j) on the cap of half-angle theta_max around wc (frame tx,
- * ty, wc; one_minus_cos = 1 - cos theta_max): uniform in solid angle over (u1, u2) of
- * light_cap_uv, u1 the cosine's share and u2 the turn. */
+/* The direction of feeler (i, j) on the cap (light_cap_at at light_cap_uv). */
 VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float one_minus_cos,
                                      float3 tx, float3 ty, float3 wc)
 {
-    float2 u = light_cap_uv(cf, i, j);
-    float u1 = u.x, u2 = u.y;
-    float cos_t = 1.0f - u1 * one_minus_cos;
-    float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
-    float phi = 2.0f * VB_PI * u2;
-    return normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+    return light_cap_at(light_cap_uv(cf, i, j), one_minus_cos, tx, ty, wc);
 }
 
 /* Reflected radiance from a spherical light of radius r > 0 that the point sees from

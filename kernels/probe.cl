@@ -138,12 +138,9 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
         float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
         for (int k = 0; k < nrays; k++) {
             uint h = vb_hash((uint)i * 7919u + (uint)k);
-            float u1 = k < 8 ? 1.0f : vb_unit_float(h); /* 8 feelers on the rim */
-            float u2 = vb_unit_float(vb_hash(h ^ 0x5bd1e995u));
-            float cos_t = 1.0f - u1 * one_minus_cos;
-            float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
-            float phi = 2.0f * VB_PI * u2;
-            float3 w = normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+            float2 u = (float2)(k < 8 ? 1.0f : vb_unit_float(h), /* 8 feelers on the rim */
+                                vb_unit_float(vb_hash(h ^ 0x5bd1e995u)));
+            float3 w = light_cap_at(u, one_minus_cos, tx, ty, wc);
             if (dot(sp.ng, w) <= 0.0f) continue;
             float b = dot(w, ls.to_c);
             float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));

@@ -106,15 +106,8 @@ VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3
     for (int k = 0; k < os->n; k++)
         for (int part = 0; part < 2; part++) {
             uint2 r = object_set_range(sc, os, k, part);
-            for (uint t = r.x; t < r.x + r.y; t++) {
-                if (skip != 0u && (tri_tag(sc->tris, (int)t) & skip) != 0u) continue;
-                float th, u, v;
-                tc->tests++;
-                if (tri_intersect(&rs, tri_vertex(sc->tris, (int)t, 0),
-                                  tri_vertex(sc->tris, (int)t, 1), tri_vertex(sc->tris, (int)t, 2),
-                                  tmax, &th, &u, &v))
-                    return 1;
-            }
+            for (uint t = r.x; t < r.x + r.y; t++)
+                if (any_test(&rs, tmax, sc->tris, (int)t, skip, &tc->tests)) return 1;
         }
     return 0;
 }
