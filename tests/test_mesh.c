@@ -599,6 +599,17 @@ static void test_ply_formats_agree(void)
     CHECK(load_text("tri.ply", tri, &t, err, sizeof err) == 0, "%s", err);
     CHECK(t.nverts == 3 && t.ntris == 1 && !t.normals, "%u verts", t.nverts);
     mesh_free(&t);
+
+    /* an element without properties holds no bytes, so any count of it is read at once
+     * (the fuzzer's 2^31 empty items once took seconds, one at a time) */
+    const char *empty = "ply\nformat binary_little_endian 1.0\nelement nothing 2147483647\n"
+                        "element vertex 3\nproperty uchar x\nproperty uchar y\nproperty uchar z\n"
+                        "element face 1\nproperty list uchar uchar vertex_indices\nend_header\n"
+                        "\0\0\0\1\0\0\0\1\0\3\0\1\2";
+    CHECK(mesh_load(write_file("empty.ply", empty, strlen(empty) + 13), &t, err, sizeof err) == 0,
+          "%s", err);
+    CHECK(t.nverts == 3 && t.ntris == 1, "%u verts %u tris", t.nverts, t.ntris);
+    mesh_free(&t);
 }
 
 static const char *ply_tri_head = "ply\nformat %s 1.0\nelement vertex %s\nproperty float x\n"

@@ -852,6 +852,8 @@ static int ply_body(const Ctx *c, const PlyHeader *h, char *p, char *endp, Mesh 
     for (int i = 0; i < h->nels; i++) {
         const PlyElement *el = &h->els[i];
         r.what = el->name;
+        /* an element without properties takes no bytes: nothing to read, however many */
+        if (el->nprops == 0) continue;
         for (uint64_t it = 0; it < el->count; it++) {
             r.item = it;
             if (ply_item(&r, h, el, m) < 0) return -1;
