@@ -38,6 +38,7 @@ typedef struct ShadePoint {
     VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
     float scale;     /* largest vertex coordinate of the triangle: sizes the ray offsets */
     int object;      /* the object whose surface it is, or -1: not known, or a texture's */
+    int tri;         /* the triangle it lies on, or -1: not known */
     int front;       /* ng is the triangle's own normal (outward, on a closed object) */
     int band;        /* wavelength band of the ray that found it, or -1: white */
 } ShadePoint;
@@ -161,65 +162,94 @@ VB_INLINE int light_cone_meets_box(float3 o, float3 axis, float d, float tan_t, 
     return 0;
 }
 
-/* The objects that feelers from ls->origin toward the light sphere (radius r, 0 for a point
- * light) may meet (VBCL_FRAME_CONE_TEST; the host sets it for scenes of at most
- * VBCL_CONE_TEST_MAX_OBJECTS objects): none, so that no feeler need be traced; a few small
- * ones (at most VB_OBJECT_SET_MAX objects of VB_OBJECT_SET_MAX_TRIS triangles in all), whose
- * triangles alone each feeler then tests, without walking the grid; or n = -1, the grid
- * (too many, or the test off). Every feeler lies in the cone
- * from the origin around the direction to the light's centre, of half-angle theta with
- * sin theta = r / d, and ends before distance d; an object can stop one only if its
- * bounding sphere meets that cone within that length (the sphere's centre no farther
- * from the cone's surface than its radius: perp cos theta - along sin theta <= R, a lower
- * bound of the distance, so the test is conservative), and, for a planar object, only if
- * its plane separates the origin from some point of the light sphere. The point's own
- * object cannot when it is planar (a feeler is traced only toward the side of the surface
- * it leaves from), nor when it is convex and the feeler leaves from the front of its
- * triangle: all of the object lies behind that triangle's plane. Margins (1e-5 of the
- * distances, the host's planarity margin) keep float rounding on the safe side: an object
- * left out is one no feeler's walk would meet, and the image is the same as with every
- * feeler walked through the grid. */
+/* The cone of a point's feelers toward a light (light_cone_objects): from o around the
+ * unit axis, half-angle theta (sin_t, cos_t), to the light's centre c at distance d, the
+ * light's radius r; reach sizes the plane test's margin. */
+typedef struct LightCone {
+    float3 o, axis, c;
+    float d, r, sin_t, cos_t, reach;
+} LightCone;
+
+/* Whether a feeler in cone k can meet a triangle that record ob bounds (an object with its
+ * texture, or a part of a texture): its bounding sphere meets the cone within its length
+ * (the sphere's centre no farther from the cone's surface than its radius: perp cos theta
+ * - along sin theta <= R, a lower bound of the distance, so the test is conservative), its
+ * box does (light_cone_meets_box), and, for a planar one, its plane separates the origin
+ * from some point of the light sphere. */
+VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
+{
+    float4 b = vload4(0, ob->bound);
+    if (b.w < 0.0f) return 0;
+    float3 v = b.xyz - k->o;
+    float along = dot(v, k->axis);
+    float perp = length(v - along * k->axis);
+    float m = b.w + 1e-5f * (k->d + fabs(along) + perp + b.w);
+    if (along < -m || along > k->d + m) return 0;
+    if (perp * k->cos_t - along * k->sin_t > m) return 0;
+    if (!light_cone_meets_box(k->o, k->axis, k->d, k->sin_t / fmax(k->cos_t, 1e-6f),
+                              vload3(0, ob->lo), vload3(0, ob->hi), m - b.w))
+        return 0;
+    if (ob->flags & VBCL_OBJECT_PLANAR) {
+        float4 pl = vload4(0, ob->plane);
+        float e = ob->plane_eps + 1e-6f * k->reach;
+        float so = dot(pl.xyz, k->o) - pl.w, sl = dot(pl.xyz, k->c) - pl.w;
+        if ((so > e && sl - k->r > e) || (so < -e && sl + k->r < -e)) return 0;
+    }
+    return 1;
+}
+
+/* The triangles that feelers from ls->origin toward the light sphere (radius r, 0 for a
+ * point light) may meet (VBCL_FRAME_CONE_TEST; the host sets it for scenes of at most
+ * VBCL_CONE_TEST_MAX_OBJECTS objects): none, so that no feeler need be traced; a few
+ * (at most VB_OBJECT_SET_MAX ranges of VB_OBJECT_SET_MAX_TRIS triangles in all), which alone
+ * each feeler then tests, without walking the grid; or n = -1, the grid (too many, or the
+ * test off). Every feeler lies in the cone from the origin around the direction to the
+ * light's centre, of half-angle theta with sin theta = r / d, and ends before distance d;
+ * an object can stop one only if the cone meets its bounds (light_cone_meets). Where it
+ * does, its own triangles are taken, and of its texture only the parts (connected pieces,
+ * VbObject.first_elem) whose own bounds the cone meets. The point's own object cannot stop
+ * a feeler when it is planar (a feeler is traced only toward the side of the surface it
+ * leaves from), nor when it is convex and the feeler leaves from the front of its
+ * triangle: all of the object lies behind that triangle's plane; the same holds for the
+ * convex part of a texture the point lies on. Margins (1e-5 of the distances, the host's
+ * planarity margin) keep float rounding on the safe side: a triangle left out is one no
+ * feeler's walk would meet, and the image is the same as with every feeler walked through
+ * the grid. */
 VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, const LightShading *ls,
                                   float r, ObjectSet *os)
 {
     os->n = -1;
     if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return;
     os->n = 0;
-    uint tris = 0u;
-    float3 o = ls->origin;
-    float3 axis = ls->to_c / ls->d;
-    float3 c = sp->p + ls->to_c;
-    float sin_t = fmin(1.0f, r / ls->d);
-    float cos_t = sqrt(fmax(0.0f, 1.0f - sin_t * sin_t));
-    float reach = vb_max3(fabs(o)) + vb_max3(fabs(c)) + r;
-    for (uint k = 0; k < scn->f->nobjects; k++) {
-        __global const VbObject *ob = scn->objects + k;
-        uint planar = ob->flags & VBCL_OBJECT_PLANAR;
-        if ((int)k == sp->object && (planar || ((ob->flags & VBCL_OBJECT_CONVEX) && sp->front)))
+    os->tris = 0u;
+    LightCone k;
+    k.o = ls->origin;
+    k.axis = ls->to_c / ls->d;
+    k.c = sp->p + ls->to_c;
+    k.d = ls->d;
+    k.r = r;
+    k.sin_t = fmin(1.0f, r / ls->d);
+    k.cos_t = sqrt(fmax(0.0f, 1.0f - k.sin_t * k.sin_t));
+    k.reach = vb_max3(fabs(k.o)) + vb_max3(fabs(k.c)) + r;
+    uint tri = (uint)sp->tri; /* -1: no part's triangle */
+    for (uint i = 0; i < scn->f->nobjects; i++) {
+        __global const VbObject *ob = scn->objects + i;
+        uint flags = ob->flags;
+        if ((int)i == sp->object &&
+            ((flags & VBCL_OBJECT_PLANAR) || ((flags & VBCL_OBJECT_CONVEX) && sp->front)))
             continue;
-        float4 b = vload4(0, ob->bound);
-        if (b.w < 0.0f) continue;
-        float3 v = b.xyz - o;
-        float along = dot(v, axis);
-        float perp = length(v - along * axis);
-        float m = b.w + 1e-5f * (ls->d + fabs(along) + perp + b.w);
-        if (along < -m || along > ls->d + m) continue;
-        if (perp * cos_t - along * sin_t > m) continue;
-        if (!light_cone_meets_box(o, axis, ls->d, sin_t / fmax(cos_t, 1e-6f), vload3(0, ob->lo),
-                                  vload3(0, ob->hi), m - b.w))
+        if (!light_cone_meets(&k, ob)) continue;
+        if (!object_set_add(os, ob->first_tri, ob->ntris)) return;
+        if (ob->nelems == 0u) {
+            if (!object_set_add(os, ob->first_tex, ob->ntex)) return;
             continue;
-        if (planar) {
-            float4 pl = vload4(0, ob->plane);
-            float e = ob->plane_eps + 1e-6f * reach;
-            float so = dot(pl.xyz, o) - pl.w, sl = dot(pl.xyz, c) - pl.w;
-            if ((so > e && sl - r > e) || (so < -e && sl + r < -e)) continue;
         }
-        tris += ob->ntris + ob->ntex;
-        if (os->n == VB_OBJECT_SET_MAX || tris > VB_OBJECT_SET_MAX_TRIS) {
-            os->n = -1;
-            return;
+        for (uint e = 0; e < ob->nelems; e++) {
+            __global const VbObject *el = scn->objects + ob->first_elem + e;
+            if (tri - el->first_tri < el->ntris && (el->flags & VBCL_OBJECT_CONVEX) && sp->front)
+                continue;
+            if (light_cone_meets(&k, el) && !object_set_add(os, el->first_tri, el->ntris)) return;
         }
-        os->obj[os->n++] = k;
     }
 }
 

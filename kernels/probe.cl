@@ -69,6 +69,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.medium = f->camera_medium;
     sp.scale = 0.0f;
     sp.object = -1;
+    sp.tri = -1;
     sp.front = 0;
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
@@ -112,6 +113,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     ShadePoint sp;
     sp.p = vload3(0, cs);
     sp.object = (int)cs[3];
+    sp.tri = (int)cs[13];
     sp.ng = normalize(vload3(0, cs + 4));
     sp.front = cs[7] > 0.0f;
     sp.ns = sp.ng;

@@ -88,6 +88,7 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     uint tag = tri_tag(sc->tris, h.tri);
     /* a texture element's surface is not its host's: the host's shape says nothing of it */
     sp.object = (tag & VBCL_TAG_TEXTURE) ? -1 : (int)(tag & ~VBCL_TAG_FLAGS);
+    sp.tri = h.tri;
     sp.front = side > 0.0f;
     sp.band = -1;
     return sp;

@@ -62,23 +62,33 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
                           org, dir, tmax, skip, tc);
 }
 
-/* A few objects, the only ones a ray may meet (the shadow cone test, light.cl, has shown
- * the rest of the scene to be out of its way), or n < 0: any object (the grid). */
-#define VB_OBJECT_SET_MAX      2  /* objects */
-#define VB_OBJECT_SET_MAX_TRIS 32 /* triangles in all, textures included */
+/* A few ranges of triangles, the only ones a ray may meet (the shadow cone test,
+ * light.cl, has shown the rest of the scene to be out of its way), or n < 0: any
+ * triangle (the grid). */
+#define VB_OBJECT_SET_MAX      4  /* ranges */
+#define VB_OBJECT_SET_MAX_TRIS 32 /* triangles in all */
 typedef struct ObjectSet {
     int n;
-    uint obj[VB_OBJECT_SET_MAX];
+    uint tris; /* triangles in all */
+    uint first[VB_OBJECT_SET_MAX], count[VB_OBJECT_SET_MAX];
 } ObjectSet;
 
-/* The triangles of the set's object k: part 0 its own, part 1 its texture's. */
-VB_INLINE uint2 object_set_range(const DevScene *sc, const ObjectSet *os, int k, int part)
+/* Adds triangles first .. first + count - 1 to the set; 0 where the set is full (n = -1:
+ * the grid from then on). */
+VB_INLINE int object_set_add(ObjectSet *os, uint first, uint count)
 {
-    __global const VbObject *ob = sc->objects + os->obj[k];
-    return part ? (uint2)(ob->first_tex, ob->ntex) : (uint2)(ob->first_tri, ob->ntris);
+    if (count == 0u) return 1;
+    os->tris += count;
+    if (os->n == VB_OBJECT_SET_MAX || os->tris > VB_OBJECT_SET_MAX_TRIS) {
+        os->n = -1;
+        return 0;
+    }
+    os->first[os->n] = first;
+    os->count[os->n++] = count;
+    return 1;
 }
 
-/* scene_trace_closest among the set's objects alone: each of their triangles tested (the
+/* scene_trace_closest among the set's triangles alone: each of them tested (the
  * same test and the same order of hits as the grid's, ties to the lower index), no walk. */
 VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, float3 org,
                                        float3 dir, float tmax, TraceCount *tc)
@@ -87,28 +97,23 @@ VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, 
     Closest c;
     closest_begin(&c, tmax);
     RayShear rs = ray_shear_make(org, dir);
-    for (int k = 0; k < os->n; k++)
-        for (int part = 0; part < 2; part++) {
-            uint2 r = object_set_range(sc, os, k, part);
-            for (uint t = r.x; t < r.x + r.y; t++)
-                closest_test(&rs, org, tmax, sc->tris, (int)t, &c);
-            tc->tests += r.y;
-        }
+    for (int k = 0; k < os->n; k++) {
+        for (uint t = os->first[k]; t < os->first[k] + os->count[k]; t++)
+            closest_test(&rs, org, tmax, sc->tris, (int)t, &c);
+        tc->tests += os->count[k];
+    }
     return c.hit;
 }
 
-/* scene_trace_any among the set's objects alone. */
+/* scene_trace_any among the set's triangles alone. */
 VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
                                  float tmax, uint skip, TraceCount *tc)
 {
     if (os->n < 0) return scene_trace_any(sc, org, dir, tmax, skip, tc);
     RayShear rs = ray_shear_make(org, dir);
     for (int k = 0; k < os->n; k++)
-        for (int part = 0; part < 2; part++) {
-            uint2 r = object_set_range(sc, os, k, part);
-            for (uint t = r.x; t < r.x + r.y; t++)
-                if (any_test(&rs, tmax, sc->tris, (int)t, skip, &tc->tests)) return 1;
-        }
+        for (uint t = os->first[k]; t < os->first[k] + os->count[k]; t++)
+            if (any_test(&rs, tmax, sc->tris, (int)t, skip, &tc->tests)) return 1;
     return 0;
 }
 

@@ -153,6 +153,13 @@ typedef struct VbObject {
     unsigned int ntris;
     unsigned int first_tex; /* its texture's triangles */
     unsigned int ntex;
+    unsigned int first_elem; /* its texture's elements: records first_elem .. first_elem +
+                              * nelems - 1 of the objects buffer, after the scene's objects,
+                              * each holding the bounds (bound, lo, hi, VBCL_OBJECT_CONVEX)
+                              * and the range (first_tri, ntris) of one part of the texture;
+                              * nelems 0: the texture is bounded as a whole */
+    unsigned int nelems;
+    unsigned int pad2[2];
 } VbObject;
 
 /* Where a ray is: inside which host (or none), and inside how many elements of each
@@ -254,6 +261,8 @@ typedef struct VbFrame {
     4u                                /* a point's feelers toward a light whose cone meets no      \
                                        * object's bounds are not traced (light_cone_objects) */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
+#define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
+    64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
  * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
@@ -290,7 +299,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
-    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -326,7 +335,8 @@ VBCL_STATIC_ASSERT(sizeof(VbGrid) == 80, grid_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGrid, n) == 64, grid_n);
 VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
-VBCL_STATIC_ASSERT(sizeof(VbObject) == 96, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 112, object_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, nelems) == 100, object_nelems);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, first_tri) == 80, object_first_tri);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ntex) == 92, object_ntex);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, bound) == 16, object_bound);

@@ -295,39 +295,66 @@ static vec3 tri_normal_d(const Mesh *m, uint32_t t, double x[3])
 /* Whether every vertex of triangles first .. first + n - 1 of m and of the texture's
  * tex_first .. tex_first + tex_n - 1 lies behind (or within eps of) the plane of each of
  * the first ones (counter-clockwise seen from the front): a convex surface with its
- * texture inside. Tested for at most 2048 triangles, texture included (the test is
- * quadratic); larger objects count as not convex, as do degenerate triangles. */
-static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex_first,
-                         uint32_t tex_n, double eps)
+ * texture inside. Tested where it takes at most `budget` vertex tests, 3 n (n + tex_n)
+ * (2^24 for an object: 2364 triangles alone, or 8 with a texture of 699,000; 2^20 for a
+ * part of a texture: 591 triangles); larger ones count as not convex, as do degenerate
+ * triangles. */
+static int cmp_u32(const void *a, const void *b)
 {
-    if (n == 0 || (uint64_t)n + tex_n > 2048) return 0;
-    for (uint32_t t = first; t < first + n; t++) {
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex_first,
+                         uint32_t tex_n, double eps, uint64_t budget)
+{
+    if (n == 0 || 3 * (uint64_t)n * ((uint64_t)n + tex_n) > budget) return 0;
+    /* each vertex once (a closed mesh's triangles share them about six ways) */
+    size_t nv = 3 * ((size_t)n + tex_n), k = 0;
+    uint32_t *vi = malloc(sizeof *vi * nv);
+    if (!vi) return 0;
+    for (uint32_t q = 0; q < n + tex_n; q++) {
+        uint32_t u = q < n ? first + q : tex_first + (q - n);
+        for (int j = 0; j < 3; j++) vi[3 * (size_t)q + j] = m->tris[3 * u + j];
+    }
+    qsort(vi, nv, sizeof *vi, cmp_u32);
+    for (size_t i = 0; i < nv; i++)
+        if (k == 0 || vi[i] != vi[k - 1]) vi[k++] = vi[i];
+    int convex = 1;
+    for (uint32_t t = first; t < first + n && convex; t++) {
         double x[3];
         vec3 p0 = tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-        if (!(len > 0.0)) return 0;
-        for (uint32_t q = 0; q < n + tex_n; q++)
-            for (int j = 0; j < 3; j++) {
-                uint32_t u = q < n ? first + q : tex_first + (q - n);
-                vec3 v = m->verts[m->tris[3 * u + j]];
-                double h = (x[0] * (v.x - p0.x) + x[1] * (v.y - p0.y) + x[2] * (v.z - p0.z)) / len;
-                if (h > eps) return 0;
+        if (!(len > 0.0)) {
+            convex = 0;
+            break;
+        }
+        for (size_t i = 0; i < k; i++) {
+            vec3 v = m->verts[vi[i]];
+            double h = (x[0] * (v.x - p0.x) + x[1] * (v.y - p0.y) + x[2] * (v.z - p0.z)) / len;
+            if (h > eps) {
+                convex = 0;
+                break;
             }
+        }
     }
-    return 1;
+    free(vi);
+    return convex;
 }
 
-/* Where object o's triangles (its texture's included) lie, for the shadow cone test
- * (light.cl, light_cone_objects): a sphere and a box holding them all, and for an object whose
- * vertices lie within 1e-6 of its size of one plane (a floor, a wall: any planar mesh),
- * that plane. Computed in double precision from the float vertices the kernels use, and
- * widened by margins far above float rounding, so the tests that use them stay
- * conservative. */
-static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
+/* Where triangles first .. first + n - 1 of m and the texture's tex_first .. tex_first +
+ * tex_n - 1 lie, for the shadow cone test (light.cl, light_cone_objects): a sphere and a box
+ * holding them all, and where every vertex lies within 1e-6 of the size of one plane (a
+ * floor, a wall: any planar mesh), that plane; VBCL_OBJECT_CONVEX as object_convex says
+ * (within `budget`).
+ * Computed in double precision from the float vertices the kernels use, and widened by
+ * margins far above float rounding, so the tests that use them stay conservative. */
+static void object_bounds(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex_first,
+                          uint32_t tex_n, uint64_t budget, VbObject *g)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    object_box(m, o->first_tri, o->ntris, lo, hi);
-    object_box(m, o->first_tex_tri, o->ntex_tris, lo, hi);
+    object_box(m, first, n, lo, hi);
+    object_box(m, tex_first, tex_n, lo, hi);
     g->bound[3] = -1.0f; /* no triangles: nothing to meet */
     if (!(lo[0] <= hi[0])) return;
     double c[3], mag = 0.0;
@@ -337,7 +364,7 @@ static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
     }
     /* the plane of the object's largest triangle */
     double nrm[3] = {0, 0, 0}, best = 0.0, k = 0.0;
-    for (uint32_t t = o->first_tri; t < o->first_tri + o->ntris; t++) {
+    for (uint32_t t = first; t < first + n; t++) {
         double x[3];
         vec3 p0 = tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
@@ -348,8 +375,8 @@ static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
         }
     }
     double r = 0.0, dev = 0.0;
-    object_spread(m, o->first_tri, o->ntris, c, nrm, k, &r, &dev);
-    object_spread(m, o->first_tex_tri, o->ntex_tris, c, nrm, k, &r, &dev);
+    object_spread(m, first, n, c, nrm, k, &r, &dev);
+    object_spread(m, tex_first, tex_n, c, nrm, k, &r, &dev);
     double margin = 1e-5 * (mag + r);
     for (int a = 0; a < 3; a++) {
         g->bound[a] = (float)c[a];
@@ -357,7 +384,7 @@ static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
         g->hi[a] = (float)(hi[a] + margin);
     }
     g->bound[3] = (float)(r + margin);
-    if (object_convex(m, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris, 1e-6 * (mag + r)))
+    if (object_convex(m, first, n, tex_first, tex_n, 1e-6 * (mag + r), budget))
         g->flags |= VBCL_OBJECT_CONVEX;
     if (best > 0.0 && dev <= 1e-6 * r) {
         g->flags |= VBCL_OBJECT_PLANAR;
@@ -367,13 +394,103 @@ static void object_bounds(const Mesh *m, const SceneObject *o, VbObject *g)
     }
 }
 
+static uint32_t uf_find(uint32_t *parent, uint32_t v)
+{
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+}
+
+/* The parts of a texture (triangles first .. first + n - 1 of m) whose bounds the shadow
+ * cone test takes one by one: the texture cut wherever the next triangle belongs to
+ * another connected piece (triangles joined by shared vertices: a bombed sphere, a tube, a
+ * ring), so each part is a stretch of one piece. Writes (first, count) pairs into runs and
+ * returns their number, or -1 where there would be more than VBCL_CONE_TEST_MAX_ELEMENTS
+ * (or no memory): the texture is then bounded as a whole. */
+static int texture_parts(const Mesh *m, uint32_t first, uint32_t n, uint32_t runs[][2])
+{
+    if (n == 0) return 0;
+    uint32_t *parent = malloc(sizeof *parent * m->nverts);
+    if (!parent) return -1;
+    for (uint32_t v = 0; v < m->nverts; v++) parent[v] = v;
+    for (uint32_t t = first; t < first + n; t++)
+        for (int k = 1; k < 3; k++) {
+            uint32_t a = uf_find(parent, m->tris[3 * t]), b = uf_find(parent, m->tris[3 * t + k]);
+            if (a != b) parent[a] = b;
+        }
+    int nruns = 0;
+    uint32_t prev = UINT32_MAX;
+    for (uint32_t t = first; t < first + n; t++) {
+        uint32_t c = uf_find(parent, m->tris[3 * t]);
+        if (nruns > 0 && c == prev) {
+            runs[nruns - 1][1]++;
+            continue;
+        }
+        if (nruns == VBCL_CONE_TEST_MAX_ELEMENTS) {
+            nruns = -1;
+            break;
+        }
+        runs[nruns][0] = t;
+        runs[nruns][1] = 1;
+        nruns++;
+        prev = c;
+    }
+    free(parent);
+    return nruns;
+}
+
+/* The objects' records for the kernels: the scene's objects, then the parts of their
+ * textures (texture_parts); *count is how many records in all. NULL: out of memory. */
+static VbObject *objects_make(const Scene *s, size_t *count)
+{
+    size_t cap = (size_t)s->nobjects + 1, n = (size_t)s->nobjects;
+    VbObject *objs = calloc(cap, sizeof *objs);
+    uint32_t(*runs)[2] = malloc(sizeof *runs * VBCL_CONE_TEST_MAX_ELEMENTS);
+    if (!objs || !runs) goto fail;
+    for (int i = 0; i < s->nobjects; i++) {
+        const SceneObject *o = &s->objects[i];
+        VbObject *g = &objs[i];
+        g->material = (unsigned)o->material;
+        g->tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
+        g->tex_slot = o->tex_slot;
+        g->flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
+        object_bounds(&s->mesh, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris, 1u << 24,
+                      g);
+        g->first_tri = o->first_tri;
+        g->ntris = o->ntris;
+        g->first_tex = o->first_tex_tri;
+        g->ntex = o->ntex_tris;
+        int nruns = texture_parts(&s->mesh, o->first_tex_tri, o->ntex_tris, runs);
+        if (nruns <= 0) continue;
+        VbObject *grown = realloc(objs, sizeof *objs * (n + (size_t)nruns));
+        if (!grown) goto fail;
+        objs = grown;
+        objs[i].first_elem = (unsigned)n;
+        objs[i].nelems = (unsigned)nruns;
+        for (int e = 0; e < nruns; e++, n++) {
+            VbObject *el = &objs[n];
+            memset(el, 0, sizeof *el);
+            object_bounds(&s->mesh, runs[e][0], runs[e][1], 0, 0, 1u << 20, el);
+            el->first_tri = runs[e][0];
+            el->ntris = runs[e][1];
+        }
+    }
+    free(runs);
+    *count = n;
+    return objs;
+fail:
+    free(objs);
+    free(runs);
+    return NULL;
+}
+
 /* Materials (the scene's, then the medium outside every host: vacuum, eta 1), their
  * patterns and band tables, objects and lights. Returns as upload_patterns. */
 static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsigned features,
                             unsigned *band_weights, char *err, size_t errlen)
 {
     VbMaterial *mats = calloc((size_t)s->nmaterials + 1, sizeof *mats);
-    VbObject *objs = calloc((size_t)s->nobjects, sizeof *objs);
+    size_t nobjs = 0;
+    VbObject *objs = objects_make(s, &nobjs);
     int rc = 1;
     snprintf(err, errlen, "out of memory");
     if (!mats || !objs) goto done;
@@ -384,21 +501,9 @@ static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsi
     rc = upload_patterns(b, dev, s, features, mats, band_weights, err, errlen);
     if (rc) goto done;
     mats[s->nmaterials].k_global = 1.0f;
-    for (int i = 0; i < s->nobjects; i++) {
-        const SceneObject *o = &s->objects[i];
-        objs[i].material = (unsigned)o->material;
-        objs[i].tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
-        objs[i].tex_slot = o->tex_slot;
-        objs[i].flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
-        object_bounds(&s->mesh, o, &objs[i]);
-        objs[i].first_tri = o->first_tri;
-        objs[i].ntris = o->ntris;
-        objs[i].first_tex = o->first_tex_tri;
-        objs[i].ntex = o->ntex_tris;
-    }
     b->materials =
         clu_buffer(dev, mats, sizeof *mats * ((size_t)s->nmaterials + 1), CL_MEM_READ_ONLY);
-    b->objects = clu_buffer(dev, objs, sizeof *objs * (size_t)s->nobjects, CL_MEM_READ_ONLY);
+    b->objects = clu_buffer(dev, objs, sizeof *objs * nobjs, CL_MEM_READ_ONLY);
     b->lights = clu_buffer(dev, s->lights, sizeof(VbLight) * (size_t)s->nlights, CL_MEM_READ_ONLY);
     rc = b->materials && b->objects && b->lights ? 0 : 1;
     if (rc) snprintf(err, errlen, "%s: %s", dev->name, clu_error());
