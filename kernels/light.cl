@@ -222,6 +222,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
     if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return;
     os->n = 0;
     os->tris = 0u;
+    os->nbig = 0;
     LightCone k;
     k.o = ls->origin;
     k.axis = ls->to_c / ls->d;
@@ -248,7 +249,16 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             __global const VbObject *el = scn->objects + ob->first_elem + e;
             if (tri - el->first_tri < el->ntris && (el->flags & VBCL_OBJECT_CONVEX) && sp->front)
                 continue;
-            if (light_cone_meets(&k, el) && !object_set_add(os, el->first_tri, el->ntris)) return;
+            if (!light_cone_meets(&k, el)) continue;
+            if (el->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
+                if (os->nbig == VB_OBJECT_SET_MAX_BIG) {
+                    os->n = -1;
+                    return;
+                }
+                os->big[os->nbig++] = ob->first_elem + e;
+            } else if (!object_set_add(os, el->first_tri, el->ntris)) {
+                return;
+            }
         }
     }
 }
@@ -358,8 +368,9 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     float3 tx, ty;
     vb_frame(wc, &tx, &ty);
     CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
-    ObjectSet os;
+    ObjectSet os, grid;
     light_cone_objects(scn, sp, ls, r, &os);
+    grid.n = -1;
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
@@ -382,12 +393,15 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
             float t_light = b - sqrt(disc);
             float3 vis;
-            if (os.n == 0) {
+            int n = os.n;
+            if (n >= 0 && os.nbig > 0 && object_set_needs_grid(scn, &os, ls->origin, w, t_light))
+                n = -1;
+            if (n == 0) {
                 sc->clear++;
                 vis = light_feeler_open(scn, sp, t_light);
             } else {
                 sc->traced++;
-                vis = light_feeler(scn, sp, &os, ls->origin, w, t_light, tc);
+                vis = light_feeler(scn, sp, n < 0 ? &grid : &os, ls->origin, w, t_light, tc);
             }
             if (vb_max3(vis) <= 0.0f) continue;
             sum_cos += vis * cos_n;
@@ -447,6 +461,7 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     float3 vis;
     ObjectSet os;
     light_cone_objects(scn, sp, &ls, 0.0f, &os);
+    if (os.n >= 0 && os.nbig > 0 && object_set_needs_grid(scn, &os, ls.origin, w, ls.d)) os.n = -1;
     if (os.n == 0) {
         sc->clear++;
         vis = light_feeler_open(scn, sp, ls.d);

@@ -94,15 +94,17 @@ __kernel void probe_optics(__global const float *in, int n, __global float *out)
 
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
  * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
- * normal), a light (centre xyz, radius), the point's triangle's scale -> out: bits 0-1 what
- * light_cone_objects says (0: the grid, 1: clear, 2: a set of objects alone; 3: the point
- * is inside the light, no test), bits 2-15 how many of nrays feelers spread over the
- * light's cap (uniform in solid angle, 8 on its rim; those leaving the surface's front
- * only, each to the near side of the sphere) the brute force contradicts: for a clear cone,
- * feelers that meet a triangle, every triangle tested; for a set, feelers whose closest hit
- * among the set's objects (scene_trace_closest_in) is not the closest of all triangles
- * (the same test, ties to the lower index), bits 16-31 such a feeler's triangle (clear) or
- * its brute-force hit + 1 (set). */
+ * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
+ * bits 0-1 what light_cone_objects says (0: the grid, 1: clear, 2: a set of triangles
+ * alone; 3: the point is inside the light, no test), bit 2 set where the set (or clear
+ * cone) has big texture parts whose bounds each feeler tests, bit 3 where some feeler met
+ * such bounds (and walks the grid, not checked here), bits 4-15 how many of nrays feelers
+ * spread over the light's cap (uniform in solid angle, 8 on its rim; those leaving the
+ * surface's front only, each to the near side of the sphere) the brute force contradicts:
+ * for a clear cone, feelers that meet a triangle, every triangle tested; for a set,
+ * feelers whose closest hit among the set's triangles (scene_trace_closest_in) is not the
+ * closest of all triangles (the same test, ties to the lower index), bits 16-31 such a
+ * feeler's triangle (clear) or its brute-force hit + 1 (set). */
 __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
                                __global uint *out)
 {
@@ -133,7 +135,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     ObjectSet os;
     light_cone_objects(&sc, &sp, &ls, r, &os);
     uint kind = os.n == 0 ? 1u : os.n > 0 ? 2u : 0u;
-    uint wrong = 0u, which = 0u;
+    uint wrong = 0u, which = 0u, big = 0u;
     if (kind != 0u) {
         float3 wc = ls.to_c / ls.d, tx, ty;
         vb_frame(wc, &tx, &ty);
@@ -146,6 +148,10 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
             if (dot(sp.ng, w) <= 0.0f) continue;
             float b = dot(w, ls.to_c);
             float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
+            if (os.nbig > 0 && object_set_needs_grid(&sc, &os, ls.origin, w, t_light)) {
+                big++; /* this feeler walks the grid, as a render's does */
+                continue;
+            }
             RayShear rs = ray_shear_make(ls.origin, w);
             Closest all;
             closest_begin(&all, t_light);
@@ -163,7 +169,8 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
             wrong += bad ? 1u : 0u;
         }
     }
-    out[i] = kind | min(wrong, 16383u) << 2 | which << 16;
+    out[i] = kind | (kind != 0u && os.nbig > 0 ? 4u : 0u) | (big > 0u ? 8u : 0u) |
+             min(wrong, 4095u) << 4 | which << 16;
 }
 
 /* The feelers' (u1, u2) of light_cap_uv (mode LIGHT_FEELERS_*) for keys key0 .. key0 +

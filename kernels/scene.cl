@@ -67,11 +67,37 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
  * triangle (the grid). */
 #define VB_OBJECT_SET_MAX      4  /* ranges */
 #define VB_OBJECT_SET_MAX_TRIS 32 /* triangles in all */
+#define VB_OBJECT_SET_MAX_BIG  4  /* parts too big for the set, each feeler tests their bounds */
 typedef struct ObjectSet {
     int n;
     uint tris; /* triangles in all */
     uint first[VB_OBJECT_SET_MAX], count[VB_OBJECT_SET_MAX];
+    int nbig; /* records (VbObject: texture parts) of big: a feeler that meets the bounding
+               * sphere of one of them walks the grid, the others test the ranges alone */
+    uint big[VB_OBJECT_SET_MAX_BIG];
 } ObjectSet;
+
+/* Whether the segment from org along the unit dir to distance t can meet the bounding
+ * sphere of record ob (conservative: margins as the cone test's). */
+VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, float3 dir, float t)
+{
+    float4 b = vload4(0, ob->bound);
+    float3 v = b.xyz - org;
+    float along = clamp(dot(v, dir), 0.0f, t);
+    float3 q = v - along * dir;
+    float m = b.w + 1e-5f * (t + length(v) + b.w);
+    return dot(q, q) <= m * m;
+}
+
+/* Whether a feeler (org, dir, t) of set os meets the bounds of one of its big parts, and
+ * must walk the grid. */
+VB_INLINE int object_set_needs_grid(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+                                    float t)
+{
+    for (int k = 0; k < os->nbig; k++)
+        if (object_segment_meets(sc->objects + os->big[k], org, dir, t)) return 1;
+    return 0;
+}
 
 /* Adds triangles first .. first + count - 1 to the set; 0 where the set is full (n = -1:
  * the grid from then on). */

@@ -530,8 +530,11 @@ static void test_light_cone_brute(void)
     fixture_run_probe(&fx, "probe_cone_brute", CASES, 4, sz, vals);
     read_buffer(mo, out, sizeof(unsigned) * CASES);
     long count[4] = {0, 0, 0, 0}, wrong[4] = {0, 0, 0, 0}, own_clear = 0, tex_sets = 0;
+    long big_sets = 0, big_met = 0;
     for (int i = 0; i < CASES; i++) {
-        unsigned kind = out[i] & 3u, nb = (out[i] >> 2) & 16383u;
+        unsigned kind = out[i] & 3u, nb = (out[i] >> 4) & 4095u;
+        big_sets += (out[i] & 4u) != 0;
+        big_met += (out[i] & 8u) != 0;
         count[kind]++;
         wrong[kind] += nb != 0;
         int obj = (int)cases[16 * i + 3];
@@ -549,17 +552,19 @@ static void test_light_cone_brute(void)
     fprintf(stderr,
             "    %u triangles, %d points: %ld clear cones (%ld on planar or convex objects, "
             "their own surface left out), %ld a set of objects alone, %ld the grid, %ld inside "
-            "a light (%ld sets from points on the texture's spheres); %ld feelers against brute "
-            "force\n",
-            m->ntris, CASES, count[1], own_clear, count[2], count[0], count[3], tex_sets,
-            (count[1] + count[2]) * RAYS);
+            "a light (%ld sets from points on the texture's spheres; %ld with spheres whose "
+            "bounds each feeler tests, %ld with feelers that meet them); %ld feelers against "
+            "brute force\n",
+            m->ntris, CASES, count[1], own_clear, count[2], count[0], count[3], tex_sets, big_sets,
+            big_met, (count[1] + count[2]) * RAYS);
     CHECK(wrong[1] == 0, "%ld clear cones have feelers that meet a triangle", wrong[1]);
     CHECK(wrong[2] == 0, "%ld cones' object sets miss a feeler's closest hit", wrong[2]);
     CHECK((count[1] + count[2]) * RAYS >= 1000000 && own_clear > count[1] / 4 &&
-              count[2] > CASES / 20 && tex_sets > CASES / 100,
+              count[2] > CASES / 20 && tex_sets > CASES / 100 && big_sets > CASES / 100 &&
+              big_met > 0 && big_met < big_sets,
           "too few cones to test: %ld clear (%ld on planar or convex objects), %ld sets (%ld from "
-          "texture points)",
-          count[1], own_clear, count[2], tex_sets);
+          "texture points, %ld with big parts, %ld with feelers meeting them)",
+          count[1], own_clear, count[2], tex_sets, big_sets, big_met);
     clReleaseMemObject(mc);
     clReleaseMemObject(mo);
     free(cases);
