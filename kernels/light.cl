@@ -85,12 +85,14 @@ VB_INLINE float3 light_feeler_open(const DevScene *sc, const ShadePoint *sp, flo
  * light being below the surface's horizon; unneeded, the BRDF giving the direction
  * nothing (no diffuse term, and outside the specular lobe: (N.H)^n < 1e-4), so that
  * whether the light is visible there changes nothing; clear, not traced because the cone
- * they lie in meets no object (light_cone_objects). */
+ * they lie in meets no object (light_cone_objects); blocked, not traced because they pass
+ * through the core of a solid texture part (object_set_feeler). */
 typedef struct ShadowCount {
     uint traced;
     uint skipped;
     uint unneeded;
     uint clear;
+    uint blocked;
 } ShadowCount;
 
 /* What shading a point under one light needs besides the point itself: the BRDF's
@@ -371,6 +373,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     ObjectSet os, grid;
     light_cone_objects(scn, sp, ls, r, &os);
     grid.n = -1;
+    int tex_free = sp->medium.tex_counts == 0u;
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
@@ -394,8 +397,14 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float t_light = b - sqrt(disc);
             float3 vis;
             int n = os.n;
-            if (n >= 0 && os.nbig > 0 && object_set_needs_grid(scn, &os, ls->origin, w, t_light))
-                n = -1;
+            if (n >= 0 && os.nbig > 0) {
+                int need = object_set_feeler(scn, &os, ls->origin, w, t_light, tex_free);
+                if (need == OBJECT_SET_BLOCKED) {
+                    sc->blocked++;
+                    continue; /* what the walk returns: nothing gets through */
+                }
+                if (need == OBJECT_SET_GRID) n = -1;
+            }
             if (n == 0) {
                 sc->clear++;
                 vis = light_feeler_open(scn, sp, t_light);
@@ -461,7 +470,14 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     float3 vis;
     ObjectSet os;
     light_cone_objects(scn, sp, &ls, 0.0f, &os);
-    if (os.n >= 0 && os.nbig > 0 && object_set_needs_grid(scn, &os, ls.origin, w, ls.d)) os.n = -1;
+    if (os.n >= 0 && os.nbig > 0) {
+        int need = object_set_feeler(scn, &os, ls.origin, w, ls.d, sp->medium.tex_counts == 0u);
+        if (need == OBJECT_SET_BLOCKED) {
+            sc->blocked++;
+            return (float3)(0.0f);
+        }
+        if (need == OBJECT_SET_GRID) os.n = -1;
+    }
     if (os.n == 0) {
         sc->clear++;
         vis = light_feeler_open(scn, sp, ls.d);

@@ -73,7 +73,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.front = 0;
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
-    ShadowCount sc2 = {0, 0, 0, 0};
+    ShadowCount sc2 = {0, 0, 0, 0, 0};
     float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
     vstore4((float4)(col, (float)sc2.traced), i, radiance);
 }
@@ -92,19 +92,98 @@ __kernel void probe_optics(__global const float *in, int n, __global float *out)
     vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);
 }
 
+#ifdef VBCL_HAS_TRANSPARENCY
+/* For probe_cone_brute: whether a feeler (org, w, t) that object_set_feeler calls blocked
+ * meets the solid part whose core it passes (every triangle of it tested), and, from a
+ * point of a surface that bounds no volume outside every host's box (where the probe's
+ * medium, the camera's, is right), whether its walk through the grid lets nothing by. */
+VB_INLINE int probe_blocked_feeler(const DevScene *sc, const ShadePoint *sp, const ObjectSet *os,
+                                   float3 org, float3 w, float t)
+{
+    int meets = 0;
+    RayShear rb = ray_shear_make(org, w);
+    for (int k = 0; k < os->nbig && !meets; k++) {
+        __global const VbObject *el = sc->objects + os->big[k];
+        if (!(el->flags & VBCL_OBJECT_SOLID) || !object_segment_through_core(el, org, w, t))
+            continue;
+        Closest cp;
+        closest_begin(&cp, t);
+        for (uint q = el->first_tri; q < el->first_tri + el->ntris; q++)
+            closest_test(&rb, org, t, sc->tris, (int)q, &cp);
+        meets = cp.hit.tri >= 0;
+    }
+    int plain = sp->object >= 0 && !(sc->objects[sp->object].flags & VBCL_OBJECT_HOST);
+    for (uint o = 0; o < sc->f->nobjects; o++) {
+        __global const VbObject *ho = sc->objects + o;
+        if ((ho->flags & VBCL_OBJECT_HOST) && all(isgreaterequal(org, vload3(0, ho->lo))) &&
+            all(islessequal(org, vload3(0, ho->hi))))
+            plain = 0;
+    }
+    float3 v = (float3)(0.0f);
+    if (plain) {
+        ObjectSet grid;
+        grid.n = -1;
+        TraceCount tw = {0, 0};
+        v = medium_shadow_transmittance(sc, &grid, org, w, t, sp->medium, -1, &tw);
+    }
+    return meets && vb_max3(v) <= 0.0f;
+}
+#endif
+
+/* For probe_cone_brute: the closest hit of the feeler (org, w, t) among all triangles but
+ * those of os's big parts, into *all; returns a big part's triangle the feeler meets
+ * inside its host (by more than 1e-4 of the scene's size; outside, a part's surface
+ * changes nothing), or 0xffffffff. */
+VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, float3 org, float3 w,
+                                    float t, Closest *all)
+{
+    RayShear rs = ray_shear_make(org, w);
+    closest_begin(all, t);
+    for (uint q = 0; q < sc->f->ntris; q++) {
+        int part = -1;
+        for (int k = 0; k < os->nbig; k++) {
+            __global const VbObject *el = sc->objects + os->big[k];
+            if (q - el->first_tri < el->ntris) part = (int)os->big[k];
+        }
+        if (part < 0) {
+            closest_test(&rs, org, t, sc->tris, (int)q, all);
+            continue;
+        }
+        float th, uh, vh;
+        if (!tri_intersect(&rs, tri_vertex(sc->tris, (int)q, 0), tri_vertex(sc->tris, (int)q, 1),
+                           tri_vertex(sc->tris, (int)q, 2), t, &th, &uh, &vh))
+            continue;
+        float3 p = org + th * w;
+        __global const VbObject *ho = sc->objects + sc->objects[part].host;
+        float depth = INFINITY; /* how far inside every host plane */
+        for (uint h = ho->first_tri; h < ho->first_tri + ho->ntris; h++) {
+            float3 v0 = tri_vertex(sc->tris, (int)h, 0).xyz;
+            float3 nq = normalize(cross(tri_vertex(sc->tris, (int)h, 1).xyz - v0,
+                                        tri_vertex(sc->tris, (int)h, 2).xyz - v0));
+            depth = fmin(depth, -dot(nq, p - v0));
+        }
+        if (depth > 1e-4f * (ho->bound[3] + vb_max3(fabs(p)))) return q;
+    }
+    return 0xffffffffu;
+}
+
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
  * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
  * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
  * bits 0-1 what light_cone_objects says (0: the grid, 1: clear, 2: a set of triangles
  * alone; 3: the point is inside the light, no test), bit 2 set where the set (or clear
  * cone) has big texture parts whose bounds each feeler tests, bit 3 where some feeler met
- * such bounds (and walks the grid, not checked here), bits 4-15 how many of nrays feelers
+ * such bounds (and walks the grid, not checked here), bit 4 where some feeler passed
+ * through a solid part's core (not traced in a render: its walk through the grid, run
+ * here, must let nothing through), bits 5-15 how many of nrays feelers
  * spread over the light's cap (uniform in solid angle, 8 on its rim; those leaving the
- * surface's front only, each to the near side of the sphere) the brute force contradicts:
+ * surface's front only, each to the near side of the sphere) the brute force (or for the
+ * blocked ones, the walk) contradicts:
  * for a clear cone, feelers that meet a triangle, every triangle tested; for a set,
  * feelers whose closest hit among the set's triangles (scene_trace_closest_in) is not the
- * closest of all triangles (the same test, ties to the lower index), bits 16-31 such a
- * feeler's triangle (clear) or its brute-force hit + 1 (set). */
+ * closest of all triangles (the same test, ties to the lower index; the big parts' left
+ * out, but a feeler that meets one inside its host is wrong), bits 16-31 such a feeler's
+ * triangle (clear) or its brute-force hit + 1 (set). */
 __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
                                __global uint *out)
 {
@@ -135,7 +214,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     ObjectSet os;
     light_cone_objects(&sc, &sp, &ls, r, &os);
     uint kind = os.n == 0 ? 1u : os.n > 0 ? 2u : 0u;
-    uint wrong = 0u, which = 0u, big = 0u;
+    uint wrong = 0u, which = 0u, big = 0u, blocked = 0u;
     if (kind != 0u) {
         float3 wc = ls.to_c / ls.d, tx, ty;
         vb_frame(wc, &tx, &ty);
@@ -148,29 +227,42 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
             if (dot(sp.ng, w) <= 0.0f) continue;
             float b = dot(w, ls.to_c);
             float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
-            if (os.nbig > 0 && object_set_needs_grid(&sc, &os, ls.origin, w, t_light)) {
+            int need = os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
+                                                       sp.medium.tex_counts == 0u)
+                                   : OBJECT_SET_ALONE;
+            if (need == OBJECT_SET_GRID) {
                 big++; /* this feeler walks the grid, as a render's does */
                 continue;
             }
-            RayShear rs = ray_shear_make(ls.origin, w);
+#ifdef VBCL_HAS_TRANSPARENCY
+            if (need == OBJECT_SET_BLOCKED) {
+                int bad = !probe_blocked_feeler(&sc, &sp, &os, ls.origin, w, t_light);
+                blocked++;
+                if (bad && !wrong) which = 0u;
+                wrong += bad ? 1u : 0u;
+                continue;
+            }
+#endif
             Closest all;
-            closest_begin(&all, t_light);
-            for (uint t = 0; t < f->ntris; t++)
-                closest_test(&rs, ls.origin, t_light, sc.tris, (int)t, &all);
+            uint inside_tri = probe_feeler_closest(&sc, &os, ls.origin, w, t_light, &all);
+            int inside_big = inside_tri != 0xffffffffu;
+            if (inside_big && !wrong) which = inside_tri;
             int bad;
-            if (kind == 1u) {
+            if (inside_big) {
+                bad = 1;
+            } else if (kind == 1u) {
                 bad = all.hit.tri >= 0;
             } else {
                 TraceCount tc = {0, 0};
                 VbHit h = scene_trace_closest_in(&sc, &os, ls.origin, w, t_light, &tc);
                 bad = h.tri != all.hit.tri || (h.tri >= 0 && h.t != all.hit.t);
             }
-            if (bad && !wrong) which = (uint)(all.hit.tri + (kind == 2u ? 1 : 0));
+            if (bad && !wrong && !inside_big) which = (uint)(all.hit.tri + (kind == 2u ? 1 : 0));
             wrong += bad ? 1u : 0u;
         }
     }
     out[i] = kind | (kind != 0u && os.nbig > 0 ? 4u : 0u) | (big > 0u ? 8u : 0u) |
-             min(wrong, 4095u) << 4 | which << 16;
+             (blocked > 0u ? 16u : 0u) | min(wrong, 2047u) << 5 | which << 16;
 }
 
 /* The feelers' (u1, u2) of light_cap_uv (mode LIGHT_FEELERS_*) for keys key0 .. key0 +
@@ -319,8 +411,9 @@ __kernel void probe_hit_surface(SCENE_KERNEL_ARGS __global const VbRay *rays,
     surface[i] = probe_primary_point(&sc, rays, hits, media, i, &sp) ? (int)sp.material : -1;
 }
 
-/* points -> feelers decided (ShadowCount.traced + clear: traced, or not traced because
- * their cone meets no object) and radiance: the renderer's local shading of each point
+/* points -> feelers decided (ShadowCount.traced + clear + blocked: traced, or not traced
+ * because their cone meets no object or they pass through a solid part's core) and
+ * radiance: the renderer's local shading of each point
  * with its shadow feelers, light_shade_local as light_sample_shading runs it. */
 __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
                                   __global const VbHit *hits, __global const VbMedium *media,
@@ -333,10 +426,11 @@ __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
     ShadePoint sp;
     float3 col = (float3)(0.0f);
     TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0, 0, 0};
+    ShadowCount shc = {0, 0, 0, 0, 0};
     if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
         col = light_shade_local(&sc, &sp, &tc, &shc);
-    traced[j] = shc.traced + shc.clear; /* decided: traced, or clear by the cone test */
+    /* decided: traced, or clear or blocked by the cone test */
+    traced[j] = shc.traced + shc.clear + shc.blocked;
     vstore4((float4)(col, 0.0f), j, radiance);
 }
 

@@ -89,14 +89,96 @@ VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, floa
     return dot(q, q) <= m * m;
 }
 
-/* Whether a feeler (org, dir, t) of set os meets the bounds of one of its big parts, and
- * must walk the grid. */
-VB_INLINE int object_set_needs_grid(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
-                                    float t)
+/* Whether the segment from org along the unit dir to distance t passes through the core
+ * of solid part ob (VBCL_OBJECT_SOLID) from outside the part's bounds: then it enters the
+ * part before t (the core lies inside it, the origin outside). The core's radius has the
+ * host's margins taken off already. */
+VB_INLINE int object_segment_through_core(__global const VbObject *ob, float3 org, float3 dir,
+                                          float t)
 {
-    for (int k = 0; k < os->nbig; k++)
-        if (object_segment_meets(sc->objects + os->big[k], org, dir, t)) return 1;
-    return 0;
+    float4 b = vload4(0, ob->bound), core = vload4(0, ob->plane);
+    float3 vb = b.xyz - org;
+    if (dot(vb, vb) <= b.w * b.w) return 0;
+    float3 v = core.xyz - org;
+    float along = dot(v, dir);
+    if (!(along > 0.0f && along < t)) return 0;
+    float3 q = v - along * dir;
+    return dot(q, q) < core.w * core.w;
+}
+
+/* The stretch [s0, s1] of the segment from org along the unit dir to distance t that lies
+ * inside the convex host ob (VBCL_OBJECT_HULL), each plane of its triangles clipping it,
+ * widened by margin m at both ends; s0 > s1 where it misses the host. */
+VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject *ob, float3 org,
+                                     float3 dir, float t, float m)
+{
+    float s0 = 0.0f, s1 = t;
+    for (uint k = ob->first_tri; k < ob->first_tri + ob->ntris; k++) {
+        float3 v0 = tri_vertex(sc->tris, (int)k, 0).xyz;
+        float3 n = cross(tri_vertex(sc->tris, (int)k, 1).xyz - v0,
+                         tri_vertex(sc->tris, (int)k, 2).xyz - v0);
+        float len = length(n);
+        float d0 = dot(n, org - v0) / len, dn = dot(n, dir) / len; /* inside: d0 + s dn <= 0 */
+        if (dn > 0.0f)
+            s1 = fmin(s1, -d0 / dn);
+        else if (dn < 0.0f)
+            s0 = fmax(s0, -d0 / dn);
+        else if (d0 > 0.0f)
+            return (float2)(1.0f, -1.0f);
+    }
+    return (float2)(s0 - m, s1 + m);
+}
+
+/* Whether the bounding sphere of part ob meets the stretch [s0, s1] of the segment from
+ * org along the unit dir. */
+VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
+{
+    float4 b = vload4(0, ob->bound);
+    float3 v = b.xyz - org;
+    float along = dot(v, dir);
+    float3 q = v - along * dir;
+    float h2 = b.w * b.w - dot(q, q);
+    if (h2 < 0.0f) return 0;
+    float h = sqrt(h2);
+    return along - h <= st.y && along + h >= st.x;
+}
+
+/* What a feeler (org, dir, t) of set os needs: OBJECT_SET_ALONE, its set's triangles alone;
+ * OBJECT_SET_GRID, the grid (it meets the bounds of one of the set's big parts);
+ * OBJECT_SET_BLOCKED, nothing: it passes through the core of a solid big part
+ * (VBCL_OBJECT_SOLID) and is stopped there, whatever it crosses before (with transparency,
+ * where the feeler starts outside every texture element: tex_free). */
+enum { OBJECT_SET_ALONE = 0, OBJECT_SET_GRID = 1, OBJECT_SET_BLOCKED = 2 };
+VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+                                float t, int tex_free)
+{
+    int need = OBJECT_SET_ALONE;
+    uint host = 0xffffffffu; /* whose stretch st is */
+    float2 st = (float2)(0.0f);
+    for (int k = 0; k < os->nbig; k++) {
+        __global const VbObject *ob = sc->objects + os->big[k];
+        if (!object_segment_meets(ob, org, dir, t)) continue;
+#ifdef VBCL_HAS_TRANSPARENCY
+        if (tex_free && (ob->flags & VBCL_OBJECT_SOLID) &&
+            object_segment_through_core(ob, org, dir, t))
+            return OBJECT_SET_BLOCKED;
+        /* outside its convex host a part's surface changes no material: the feeler need
+         * only meet it inside */
+        __global const VbObject *ho = sc->objects + ob->host;
+        if (ho->flags & VBCL_OBJECT_HULL) {
+            if (ob->host != host) {
+                host = ob->host;
+                st = object_hull_stretch(sc, ho, org, dir, t,
+                                         1e-5f * (t + vb_max3(fabs(org)) + ho->bound[3]));
+            }
+            if (!object_stretch_meets(ob, org, dir, st)) continue;
+        }
+#else
+        (void)tex_free;
+#endif
+        need = OBJECT_SET_GRID;
+    }
+    return need;
 }
 
 /* Adds triangles first .. first + count - 1 to the set; 0 where the set is full (n = -1:

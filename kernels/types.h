@@ -40,6 +40,14 @@
 #define VBCL_OBJECT_HOST   1u /* a closed volume whose inside the medium state tracks */
 #define VBCL_OBJECT_PLANAR 2u /* every triangle of the object lies in VbObject.plane */
 #define VBCL_OBJECT_CONVEX 4u /* every vertex lies behind (or on) every triangle's plane */
+#define VBCL_OBJECT_HULL                                                                           \
+    16u /* its own triangles bound a convex volume (its texture aside): a feeler's stretch         \
+         * inside it is the segment clipped by their planes */
+#define VBCL_OBJECT_SOLID                                                                          \
+    8u /* a texture part that is convex, of an opaque material, strictly inside its convex         \
+        * host and apart from the texture's other parts: VbObject.plane holds a sphere inside      \
+        * it (its core), and a feeler from outside its bounds that passes through the core is      \
+        * stopped by it, whatever it meets on the way */
 
 /* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices
@@ -64,13 +72,14 @@
     X(SPLITS,          13, splits,          ray_tree, "splits")           /* white -> bands */     \
     X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */     \
     X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */  \
-    X(SHADOW_CLEAR,    16, shadow_clear,    rays,     "shadow_clear")     /* cone meets nothing */
+    X(SHADOW_CLEAR,    16, shadow_clear,    rays,     "shadow_clear")     /* cone meets nothing */ \
+    X(SHADOW_BLOCKED,  17, shadow_blocked,  rays,     "shadow_blocked")   /* through a solid core */
 /* clang-format on */
 #define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
 enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
-#define VBCL_COUNT_DEPTH0     17 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH0     18 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS 16
-#define VBCL_COUNTERS         33
+#define VBCL_COUNTERS         34
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {
@@ -146,9 +155,10 @@ typedef struct VbObject {
     float lo[3];               /* the triangles' bounding box, widened by the same margin */
     float plane_eps;           /* the vertices' largest distance from the plane, plus a margin */
     float hi[3];
-    unsigned int pad;
+    unsigned int host;      /* a texture part's record: the object whose texture it is */
     float plane[4];         /* VBCL_OBJECT_PLANAR: unit normal n and offset k (n.x = k on
-                             * the plane); w: k. Each vertex lies within plane_eps of it */
+                             * the plane); w: k. Each vertex lies within plane_eps of it.
+                             * VBCL_OBJECT_SOLID (never planar): the core, centre and radius */
     unsigned int first_tri; /* its own triangles: first_tri .. first_tri + ntris - 1 */
     unsigned int ntris;
     unsigned int first_tex; /* its texture's triangles */

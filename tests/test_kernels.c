@@ -444,14 +444,18 @@ static void test_light_irradiance_closed_form(void)
 
 /* The shadow cone test (light_cone_objects) against brute force: points on every kind of
  * surface (a floor and a tilted wall: planar; a box, a prism, a sphere: convex; a vase:
- * neither; a glass box with a texture of bombed spheres, each sphere a part bounded on its
- * own), on either side, under lights of random places and sizes. Wherever the test says
- * the cone is clear, none of 128 feelers per point over the light's cap (its rim
- * included), each tested against every triangle, may meet one; over a million such
- * feelers. The test must also find clear cones, planar and convex surfaces' own included.
- * Where it names a few triangles as the only ones in the way, the closest hit among them
- * is every feeler's closest hit of all; such sets must also come from points on the
- * texture's spheres (the box's triangles without the spheres the cone misses). */
+ * neither; a glass prism with a texture of bombed spheres, some reaching out of it, each
+ * sphere a part bounded on its own), on either side, under lights of random places and
+ * sizes. Wherever the test says the cone is clear, none of 128 feelers per point over the
+ * light's cap (its rim included), each tested against every triangle, may meet one; over
+ * a million such feelers. The test must also find clear cones, planar and convex surfaces'
+ * own included. Where it names a few triangles as the only ones in the way, the closest
+ * hit among them is every feeler's closest hit of all, the big spheres' triangles aside,
+ * which such a feeler may meet only outside the prism (where they change nothing); such
+ * sets must also come from points on the texture's spheres (the prism's triangles without
+ * the spheres the cone misses). Feelers that pass through the core of a solid sphere,
+ * which a render does not trace, must meet that sphere and, where the probe knows their
+ * medium, be stopped by the walk through the grid. */
 static void test_light_cone_brute(void)
 {
     Fixture fx;
@@ -472,8 +476,9 @@ static void test_light_cone_brute(void)
             "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","
             " \"profile\": [[0.5, 0], [0.2, 0.6], [0.6, 1.2], [0.3, 1.6]],"
             " \"transform\": {\"translate\": [0.5, 0, -1]}},"
-            "{\"shape\": \"box\", \"size\": [1.6, 1.6, 1.6], \"material\": \"g\","
-            " \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, 0.8, 2]},"
+            "{\"shape\": \"prism\", \"depth\": 1.6, \"points\": [[-0.9, 0], [0.9, 0], [0, 1.5]],"
+            " \"material\": \"g\", \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, "
+            "0.05, 2]},"
             " \"texture\": {\"generate\": \"bomb --shape sphere --count 6 --size 20:30 --seed 3\","
             " \"material\": \"e\"}}]}"))
         return;
@@ -530,11 +535,12 @@ static void test_light_cone_brute(void)
     fixture_run_probe(&fx, "probe_cone_brute", CASES, 4, sz, vals);
     read_buffer(mo, out, sizeof(unsigned) * CASES);
     long count[4] = {0, 0, 0, 0}, wrong[4] = {0, 0, 0, 0}, own_clear = 0, tex_sets = 0;
-    long big_sets = 0, big_met = 0;
+    long big_sets = 0, big_met = 0, blocked = 0;
     for (int i = 0; i < CASES; i++) {
-        unsigned kind = out[i] & 3u, nb = (out[i] >> 4) & 4095u;
+        unsigned kind = out[i] & 3u, nb = (out[i] >> 5) & 2047u;
         big_sets += (out[i] & 4u) != 0;
         big_met += (out[i] & 8u) != 0;
+        blocked += (out[i] & 16u) != 0;
         count[kind]++;
         wrong[kind] += nb != 0;
         int obj = (int)cases[16 * i + 3];
@@ -553,18 +559,18 @@ static void test_light_cone_brute(void)
             "    %u triangles, %d points: %ld clear cones (%ld on planar or convex objects, "
             "their own surface left out), %ld a set of objects alone, %ld the grid, %ld inside "
             "a light (%ld sets from points on the texture's spheres; %ld with spheres whose "
-            "bounds each feeler tests, %ld with feelers that meet them); %ld feelers against "
-            "brute force\n",
+            "bounds each feeler tests, %ld with feelers that meet them, %ld with feelers through "
+            "a solid sphere's core); %ld feelers against brute force\n",
             m->ntris, CASES, count[1], own_clear, count[2], count[0], count[3], tex_sets, big_sets,
-            big_met, (count[1] + count[2]) * RAYS);
+            big_met, blocked, (count[1] + count[2]) * RAYS);
     CHECK(wrong[1] == 0, "%ld clear cones have feelers that meet a triangle", wrong[1]);
     CHECK(wrong[2] == 0, "%ld cones' object sets miss a feeler's closest hit", wrong[2]);
     CHECK((count[1] + count[2]) * RAYS >= 1000000 && own_clear > count[1] / 4 &&
               count[2] > CASES / 20 && tex_sets > CASES / 100 && big_sets > CASES / 100 &&
-              big_met > 0 && big_met < big_sets,
+              big_met > 0 && big_met < big_sets && blocked > CASES / 200,
           "too few cones to test: %ld clear (%ld on planar or convex objects), %ld sets (%ld from "
-          "texture points, %ld with big parts, %ld with feelers meeting them)",
-          count[1], own_clear, count[2], tex_sets, big_sets, big_met);
+          "texture points, %ld with big parts, %ld with feelers meeting them, %ld through a core)",
+          count[1], own_clear, count[2], tex_sets, big_sets, big_met, blocked);
     clReleaseMemObject(mc);
     clReleaseMemObject(mo);
     free(cases);

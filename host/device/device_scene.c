@@ -438,6 +438,115 @@ static int texture_parts(const Mesh *m, uint32_t first, uint32_t n, uint32_t run
     return nruns;
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Whether triangles first .. first + n - 1 of m form a closed surface by their vertex
+ * indices: every edge a -> b has its reverse b -> a among them. */
+static int part_closed(const Mesh *m, uint32_t first, uint32_t n)
+{
+    uint64_t *e = malloc(sizeof *e * 3 * (size_t)n);
+    if (!e) return 0;
+    for (uint32_t t = 0; t < n; t++)
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = m->tris[3 * (first + t) + k], b = m->tris[3 * (first + t) + (k + 1) % 3];
+            e[3 * (size_t)t + k] = a << 32 | b;
+        }
+    qsort(e, 3 * (size_t)n, sizeof *e, cmp_u64);
+    int closed = 1;
+    for (size_t i = 0; i < 3 * (size_t)n && closed; i++) {
+        uint64_t rev = e[i] << 32 | e[i] >> 32;
+        closed = bsearch(&rev, e, 3 * (size_t)n, sizeof *e, cmp_u64) != NULL;
+    }
+    free(e);
+    return closed;
+}
+
+/* A sphere inside the convex part first .. first + n - 1 of m (core: centre, radius): the
+ * mean of its corners, and its least distance from the part's planes less 0.1% and
+ * margin. 0 where there is none (the centre not strictly inside every plane). */
+static int part_core(const Mesh *m, uint32_t first, uint32_t n, double margin, float core[4])
+{
+    double c[3] = {0, 0, 0};
+    for (uint32_t t = first; t < first + n; t++)
+        for (int k = 0; k < 3; k++) {
+            vec3 v = m->verts[m->tris[3 * t + k]];
+            c[0] += v.x / (3.0 * n);
+            c[1] += v.y / (3.0 * n);
+            c[2] += v.z / (3.0 * n);
+        }
+    double r = INFINITY;
+    for (uint32_t t = first; t < first + n; t++) {
+        double x[3];
+        vec3 p0 = tri_normal_d(m, t, x);
+        double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        double h = (x[0] * (c[0] - p0.x) + x[1] * (c[1] - p0.y) + x[2] * (c[2] - p0.z)) / len;
+        if (!(h < 0.0)) return 0;
+        r = fmin(r, -h);
+    }
+    r = r * (1.0 - 1e-3) - margin;
+    if (!(r > 0.0)) return 0;
+    for (int a = 0; a < 3; a++) core[a] = (float)c[a];
+    core[3] = (float)r;
+    return 1;
+}
+
+/* Shrinks the sphere core (centre, radius) to lie behind every plane of the host's
+ * triangles host .. host + host_n - 1 of m by margin: inside the host, where the host is
+ * convex. 0 where its centre is not that far inside. */
+static int core_inside(const Mesh *m, float core[4], uint32_t host, uint32_t host_n, double margin)
+{
+    double r = core[3];
+    for (uint32_t h = host; h < host + host_n; h++) {
+        double x[3];
+        vec3 p0 = tri_normal_d(m, h, x);
+        double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        if (!(len > 0.0)) return 0;
+        double d =
+            (x[0] * (core[0] - p0.x) + x[1] * (core[1] - p0.y) + x[2] * (core[2] - p0.z)) / len;
+        r = fmin(r, -d - margin);
+    }
+    if (!(r > margin)) return 0;
+    core[3] = (float)r;
+    return 1;
+}
+
+/* Marks the solid parts (VBCL_OBJECT_SOLID) among the nparts records parts of object o's
+ * texture (o's record g), with a core (part_core) in VbObject.plane: o a convex host whose
+ * texture material T is opaque and no object's own material, the part closed, convex and
+ * not planar, its core shrunk to lie inside o. A feeler that starts outside every texture element
+ * and reaches a point of the core is there inside o and inside the part, where the material is T;
+ * it started elsewhere, and the only crossings into T are entering ones (into the part, or into o
+ * while inside a part), whose surface is T: opaque. So the walk returns nothing whatever it meets
+ * on the way (a part that reaches out of o included), and the feeler need not be traced. */
+static void parts_solid(const Scene *s, const SceneObject *o, const VbObject *g, VbObject *parts,
+                        int nparts)
+{
+    const Mesh *m = &s->mesh;
+    double mag = 0.0;
+    for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(g->lo[a]), fabs(g->hi[a])));
+    double margin = 1e-5 * (mag + g->bound[3]);
+    if (!o->is_host || !(g->flags & VBCL_OBJECT_HULL) ||
+        s->materials[o->tex_material].gpu.k_global > 0.0f)
+        return;
+    for (int j = 0; j < s->nobjects; j++)
+        if (s->objects[j].material == o->tex_material) return;
+    for (int e = 0; e < nparts; e++) {
+        VbObject *el = &parts[e];
+        if (!(el->flags & VBCL_OBJECT_CONVEX) || (el->flags & VBCL_OBJECT_PLANAR)) continue;
+        float core[4];
+        if (part_closed(m, el->first_tri, el->ntris) &&
+            part_core(m, el->first_tri, el->ntris, margin, core) &&
+            core_inside(m, core, o->first_tri, o->ntris, margin)) {
+            el->flags |= VBCL_OBJECT_SOLID;
+            memcpy(el->plane, core, sizeof core);
+        }
+    }
+}
+
 /* The objects' records for the kernels: the scene's objects, then the parts of their
  * textures (texture_parts); *count is how many records in all. NULL: out of memory. */
 static VbObject *objects_make(const Scene *s, size_t *count)
@@ -461,6 +570,11 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         g->ntex = o->ntex_tris;
         int nruns = texture_parts(&s->mesh, o->first_tex_tri, o->ntex_tris, runs);
         if (nruns <= 0) continue;
+        double mag = 0.0;
+        for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(g->lo[a]), fabs(g->hi[a])));
+        if (o->is_host && object_convex(&s->mesh, o->first_tri, o->ntris, 0, 0,
+                                        1e-6 * (mag + g->bound[3]), 1u << 24))
+            g->flags |= VBCL_OBJECT_HULL;
         VbObject *grown = realloc(objs, sizeof *objs * (n + (size_t)nruns));
         if (!grown) goto fail;
         objs = grown;
@@ -472,7 +586,9 @@ static VbObject *objects_make(const Scene *s, size_t *count)
             object_bounds(&s->mesh, runs[e][0], runs[e][1], 0, 0, 1u << 20, el);
             el->first_tri = runs[e][0];
             el->ntris = runs[e][1];
+            el->host = (unsigned)i;
         }
+        parts_solid(s, o, &objs[i], objs + objs[i].first_elem, nruns);
     }
     free(runs);
     *count = n;
