@@ -265,6 +265,31 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
     }
 }
 
+/* What feeler (w, t) from origin lets through, where the point's cone gave set os (and
+ * tex_free: the point lies outside every texture element), counted in sc by how it was
+ * decided: blocked (object_set_feeler: through a solid part's core, nothing gets
+ * through), clear (nothing in the way: light_feeler_open), or traced through the set's
+ * triangles alone or the grid. */
+VB_INLINE float3 light_feeler_decided(const DevScene *scn, const ShadePoint *sp,
+                                      const ObjectSet *os, float3 origin, float3 w, float t,
+                                      int tex_free, TraceCount *tc, ShadowCount *sc)
+{
+    int need = os->n >= 0 && os->nbig > 0 ? object_set_feeler(scn, os, origin, w, t, tex_free)
+                                          : (os->n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
+    if (need == OBJECT_SET_BLOCKED) {
+        sc->blocked++;
+        return (float3)(0.0f);
+    }
+    if (need == OBJECT_SET_ALONE && os->n == 0) {
+        sc->clear++;
+        return light_feeler_open(scn, sp, t);
+    }
+    sc->traced++;
+    ObjectSet grid;
+    grid.n = -1;
+    return light_feeler(scn, sp, need == OBJECT_SET_GRID ? &grid : os, origin, w, t, tc);
+}
+
 /* Whether the BRDF gives direction w anything: a diffuse term, or w inside the specular
  * lobe ((N.H)^n >= 1e-4), with *nh = N.H. A feeler the BRDF gives nothing is not traced:
  * the light's visibility there cannot change the image. */
@@ -370,9 +395,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     float3 tx, ty;
     vb_frame(wc, &tx, &ty);
     CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
-    ObjectSet os, grid;
+    ObjectSet os;
     light_cone_objects(scn, sp, ls, r, &os);
-    grid.n = -1;
     int tex_free = sp->medium.tex_counts == 0u;
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
@@ -395,23 +419,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float b = dot(w, ls->to_c);
             float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
             float t_light = b - sqrt(disc);
-            float3 vis;
-            int n = os.n;
-            if (n >= 0 && os.nbig > 0) {
-                int need = object_set_feeler(scn, &os, ls->origin, w, t_light, tex_free);
-                if (need == OBJECT_SET_BLOCKED) {
-                    sc->blocked++;
-                    continue; /* what the walk returns: nothing gets through */
-                }
-                if (need == OBJECT_SET_GRID) n = -1;
-            }
-            if (n == 0) {
-                sc->clear++;
-                vis = light_feeler_open(scn, sp, t_light);
-            } else {
-                sc->traced++;
-                vis = light_feeler(scn, sp, n < 0 ? &grid : &os, ls->origin, w, t_light, tc);
-            }
+            float3 vis =
+                light_feeler_decided(scn, sp, &os, ls->origin, w, t_light, tex_free, tc, sc);
             if (vb_max3(vis) <= 0.0f) continue;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
@@ -467,24 +476,10 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
 #ifdef VBCL_HAS_SPECULAR
     if (ls.specular && nh > ls.nh_min) brdf += ls.ks * (ls.spec_norm * powr(nh, ls.exponent));
 #endif
-    float3 vis;
     ObjectSet os;
     light_cone_objects(scn, sp, &ls, 0.0f, &os);
-    if (os.n >= 0 && os.nbig > 0) {
-        int need = object_set_feeler(scn, &os, ls.origin, w, ls.d, sp->medium.tex_counts == 0u);
-        if (need == OBJECT_SET_BLOCKED) {
-            sc->blocked++;
-            return (float3)(0.0f);
-        }
-        if (need == OBJECT_SET_GRID) os.n = -1;
-    }
-    if (os.n == 0) {
-        sc->clear++;
-        vis = light_feeler_open(scn, sp, ls.d);
-    } else {
-        sc->traced++;
-        vis = light_feeler(scn, sp, &os, ls.origin, w, ls.d, tc);
-    }
+    float3 vis =
+        light_feeler_decided(scn, sp, &os, ls.origin, w, ls.d, sp->medium.tex_counts == 0u, tc, sc);
     if (vb_max3(vis) <= 0.0f) return (float3)(0.0f);
     return radiance * brdf * vis * (cos_n / ls.d2);
 }

@@ -77,16 +77,26 @@ typedef struct ObjectSet {
     uint big[VB_OBJECT_SET_MAX_BIG];
 } ObjectSet;
 
-/* Whether the segment from org along the unit dir to distance t can meet the bounding
- * sphere of record ob (conservative: margins as the cone test's). */
-VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, float3 dir, float t)
+/* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
+ * bounding sphere of record ob (conservative: margins as the cone test's). */
+VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
 {
     float4 b = vload4(0, ob->bound);
     float3 v = b.xyz - org;
-    float along = clamp(dot(v, dir), 0.0f, t);
+    float along = dot(v, dir);
     float3 q = v - along * dir;
-    float m = b.w + 1e-5f * (t + length(v) + b.w);
-    return dot(q, q) <= m * m;
+    float m = b.w + 1e-5f * (fabs(st.y) + length(v) + b.w);
+    float h2 = m * m - dot(q, q);
+    if (h2 < 0.0f) return 0;
+    float h = sqrt(h2);
+    return along - h <= st.y && along + h >= st.x;
+}
+
+/* Whether the segment from org along the unit dir to distance t can meet the bounding
+ * sphere of record ob. */
+VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, float3 dir, float t)
+{
+    return object_stretch_meets(ob, org, dir, (float2)(0.0f, t));
 }
 
 /* Whether the segment from org along the unit dir to distance t passes through the core
@@ -127,20 +137,6 @@ VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject
             return (float2)(1.0f, -1.0f);
     }
     return (float2)(s0 - m, s1 + m);
-}
-
-/* Whether the bounding sphere of part ob meets the stretch [s0, s1] of the segment from
- * org along the unit dir. */
-VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
-{
-    float4 b = vload4(0, ob->bound);
-    float3 v = b.xyz - org;
-    float along = dot(v, dir);
-    float3 q = v - along * dir;
-    float h2 = b.w * b.w - dot(q, q);
-    if (h2 < 0.0f) return 0;
-    float h = sqrt(h2);
-    return along - h <= st.y && along + h >= st.x;
 }
 
 /* What a feeler (org, dir, t) of set os needs: OBJECT_SET_ALONE, its set's triangles alone;

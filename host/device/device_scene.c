@@ -292,6 +292,12 @@ static vec3 tri_normal_d(const Mesh *m, uint32_t t, double x[3])
     return p0;
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* Whether every vertex of triangles first .. first + n - 1 of m and of the texture's
  * tex_first .. tex_first + tex_n - 1 lies behind (or within eps of) the plane of each of
  * the first ones (counter-clockwise seen from the front): a convex surface with its
@@ -299,12 +305,6 @@ static vec3 tri_normal_d(const Mesh *m, uint32_t t, double x[3])
  * (2^24 for an object: 2364 triangles alone, or 8 with a texture of 699,000; 2^20 for a
  * part of a texture: 591 triangles); larger ones count as not convex, as do degenerate
  * triangles. */
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
 static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex_first,
                          uint32_t tex_n, double eps, uint64_t budget)
 {
