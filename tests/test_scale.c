@@ -153,11 +153,10 @@ static void test_scale_stats_per_device(void)
  * exit 2, one line naming the list, nothing written. */
 static void test_scale_bad_device_lists(void)
 {
-    static const char *bad[][2] = {{"0,0", "named twice"},
-                                   {"0,", "separated by commas"},
-                                   {",0", "separated by commas"},
-                                   {"0,99", "no such device 99"},
-                                   {"0,no-such-gpu", "no device name contains"}};
+    static const char *bad[][2] = {
+        {"0,0", "named twice"},        {"pocl,portable", "named twice"}, /* one PoCL device */
+        {"0,", "separated by commas"}, {",0", "separated by commas"},
+        {"0,99", "no such device 99"}, {"0,no-such-gpu", "no device name contains"}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         char cmd[2048], out[4096], img[1024];
         snprintf(img, sizeof img, "%s/scale_bad.png", tu_tmpdir());
@@ -183,6 +182,31 @@ static cJSON *read_json(const char *path)
     cJSON *doc = cJSON_Parse(text);
     CHECK(doc != NULL, "%s does not parse", path);
     return doc;
+}
+
+/* Names in a device list pick among the devices the list has not named yet: with two PoCL
+ * devices of the same name, "pocl,pocl" is both of them ("pocl" is in PoCL's version). */
+static void test_scale_device_names(void)
+{
+    if (!two_devices()) {
+        th_skip("PoCL does not list two devices under POCL_DEVICES='pthread pthread'");
+        return;
+    }
+    char cmd[2048], out[4096], path[1024];
+    snprintf(path, sizeof path, "%s/scale_names.json", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             TWO_POCL "%s tests/scenes/tiny.json -q --device pocl,pocl -o %s/scale_names.png "
+                      "--stats-json %s",
+             tu_vbcl, tu_tmpdir(), path);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, out);
+    cJSON *doc = read_json(path);
+    if (!doc) return;
+    const cJSON *devs = cJSON_GetObjectItemCaseSensitive(doc, "devices");
+    CHECK(cJSON_GetArraySize(devs) == 2 && json_num(cJSON_GetArrayItem(devs, 0), "index") == 0 &&
+              json_num(cJSON_GetArrayItem(devs, 1), "index") == 1,
+          "--device pocl,pocl: %d devices", cJSON_GetArraySize(devs));
+    cJSON_Delete(doc);
 }
 
 /* "mpirun -np 2 --oversubscribe" (and --allow-run-as-root as root, as in CI), or NULL
@@ -320,6 +344,7 @@ void suite_scale(void)
     RUN_TEST(test_scale_devices_identical);
     RUN_TEST(test_scale_stats_per_device);
     RUN_TEST(test_scale_bad_device_lists);
+    RUN_TEST(test_scale_device_names);
     RUN_TEST(test_scale_mpi_identical);
     RUN_TEST(test_scale_mpi_failure);
 }

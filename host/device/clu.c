@@ -192,10 +192,29 @@ static int contains_nocase(const char *hay, const char *needle)
     return n == 0;
 }
 
-/* The device one item of a --device list names: an index, or the first device whose
- * "platform / device" contains it. Returns the index, or -1 after a message in err. */
+/* Whether device i (platform plat) matches item by its platform's name (pass 0) or by its
+ * own name or version (pass 1: PoCL says "PoCL" only in its version). */
+static int device_matches(cl_platform_id plat, cl_device_id dev, const char *item, int pass)
+{
+    char text[512] = "";
+    if (pass == 0) {
+        clGetPlatformInfo(plat, CL_PLATFORM_NAME, sizeof text, text, NULL);
+        return contains_nocase(text, item);
+    }
+    clGetDeviceInfo(dev, CL_DEVICE_NAME, sizeof text, text, NULL);
+    if (contains_nocase(text, item)) return 1;
+    clGetDeviceInfo(dev, CL_DEVICE_VERSION, sizeof text, text, NULL);
+    return contains_nocase(text, item);
+}
+
+/* The device one item of a --device list names: an index, or among the devices not picked
+ * yet (picks[0 .. count - 1]) the first whose platform's name contains it, else the first
+ * whose own name or version does; so "pocl,intel" names PoCL and Intel's runtime even on an
+ * Intel CPU, whose name PoCL's device carries. Returns the index, or -1 after a message
+ * in err. */
 static int device_pick(const char *spec, const char *item, cl_platform_id *plats,
-                       cl_device_id *devs, int n, char *err, size_t errlen)
+                       cl_device_id *devs, int n, const int *picks, int count, char *err,
+                       size_t errlen)
 {
     char *end;
     long idx = strtol(item, &end, 10);
@@ -205,13 +224,20 @@ static int device_pick(const char *spec, const char *item, cl_platform_id *plats
                  spec, item, n);
         return -1;
     }
-    for (int i = 0; i < n; i++) {
-        char name[256];
-        full_name(plats[i], devs[i], name, sizeof name);
-        if (contains_nocase(name, item)) return i;
-    }
-    snprintf(err, errlen, "--device %s: no device name contains \"%s\" (see --list-devices)", spec,
-             item);
+    int named = -1; /* a matching device already picked */
+    for (int pass = 0; pass < 2; pass++)
+        for (int i = 0; i < n; i++) {
+            if (!device_matches(plats[i], devs[i], item, pass)) continue;
+            int taken = 0;
+            for (int k = 0; k < count; k++) taken |= picks[k] == i;
+            if (!taken) return i;
+            named = i;
+        }
+    if (named >= 0)
+        snprintf(err, errlen, "--device %s: device %d is named twice", spec, named);
+    else
+        snprintf(err, errlen, "--device %s: no device name contains \"%s\" (see --list-devices)",
+                 spec, item);
     return -1;
 }
 
@@ -241,7 +267,7 @@ int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t err
         }
         memcpy(item, p, len);
         item[len] = 0;
-        int pick = device_pick(spec, item, plats, devs, n, err, errlen);
+        int pick = device_pick(spec, item, plats, devs, n, picks, count, err, errlen);
         if (pick < 0) return -2;
         for (int k = 0; k < count; k++)
             if (picks[k] == pick) {

@@ -68,8 +68,9 @@ int clu_list_devices(FILE *out);
 #define CLU_MAX_DEVICES 16
 
 /* The devices spec names, as indices of clu_list_devices: "all", or a comma-separated list
- * of items, each an index or a case-insensitive part of "platform / device" (the first
- * device that contains it); NULL or "" is device 0. Returns how many (<= max) are in
+ * of items, each an index or a case-insensitive part of a name (among the devices the list
+ * has not named yet, the first whose platform's name contains it, else whose device name
+ * or version does); NULL or "" is device 0. Returns how many (<= max) are in
  * picks, -1 when there is no OpenCL device at all, or -2 when spec is not a valid list
  * (a usage error: an item that matches nothing, a device named twice); err says which. */
 int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t errlen);
