@@ -103,6 +103,33 @@ static double json_num(const cJSON *o, const char *key)
     return cJSON_IsNumber(v) ? v->valuedouble : -1.0;
 }
 
+/* Reads a --stats-json document (caller frees), or NULL after a failed check. */
+static cJSON *read_json(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    static char text[1 << 20];
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = 0;
+    cJSON *doc = cJSON_Parse(text);
+    CHECK(doc != NULL, "%s does not parse", path);
+    return doc;
+}
+
+/* Renders `args` on two PoCL devices (TWO_POCL) with --stats-json into the temporary
+ * directory as NAME.png and NAME.json; returns the document (caller frees), or NULL after
+ * a failed check. */
+static cJSON *two_pocl_stats(const char *args, const char *name)
+{
+    char cmd[2048], out[4096], path[1024];
+    snprintf(path, sizeof path, "%s/%s.json", tu_tmpdir(), name);
+    snprintf(cmd, sizeof cmd, TWO_POCL "%s %s -q -o %s/%s.png --stats-json %s", tu_vbcl, args,
+             tu_tmpdir(), name, path);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, out);
+    return rc == 0 ? read_json(path) : NULL;
+}
+
 /* --stats-json "devices": one entry per device; their tiles and rays add up to the frame's. */
 static void test_scale_stats_per_device(void)
 {
@@ -110,21 +137,8 @@ static void test_scale_stats_per_device(void)
         th_skip("PoCL does not list two devices under POCL_DEVICES='pthread pthread'");
         return;
     }
-    char cmd[2048], out[4096], path[1024];
-    snprintf(path, sizeof path, "%s/scale_stats.json", tu_tmpdir());
-    snprintf(cmd, sizeof cmd,
-             TWO_POCL "%s scenes/quickstart.json -q --width 64 --height 64 --aa 0.6 --device all "
-                      "-o %s/scale_stats.png --stats-json %s",
-             tu_vbcl, tu_tmpdir(), path);
-    int rc = tu_run(cmd, out, sizeof out);
-    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, out);
-    FILE *f = fopen(path, "rb");
-    char text[65536] = "";
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    if (f) fclose(f);
-    text[n] = 0;
-    cJSON *doc = cJSON_Parse(text);
-    CHECK(doc != NULL, "%s does not parse", path);
+    cJSON *doc = two_pocl_stats(
+        "scenes/quickstart.json --width 64 --height 64 --aa 0.6 --device all", "scale_stats");
     if (!doc) return;
     const cJSON *devs = cJSON_GetObjectItemCaseSensitive(doc, "devices");
     const cJSON *tiles = cJSON_GetObjectItemCaseSensitive(doc, "tiles");
@@ -171,19 +185,6 @@ static void test_scale_bad_device_lists(void)
     }
 }
 
-/* Reads a --stats-json document (caller frees), or NULL after a failed check. */
-static cJSON *read_json(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    static char text[1 << 20];
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    if (f) fclose(f);
-    text[n] = 0;
-    cJSON *doc = cJSON_Parse(text);
-    CHECK(doc != NULL, "%s does not parse", path);
-    return doc;
-}
-
 /* Names in a device list pick among the devices the list has not named yet: with two PoCL
  * devices of the same name, "pocl,pocl" is both of them ("pocl" is in PoCL's version). */
 static void test_scale_device_names(void)
@@ -192,15 +193,7 @@ static void test_scale_device_names(void)
         th_skip("PoCL does not list two devices under POCL_DEVICES='pthread pthread'");
         return;
     }
-    char cmd[2048], out[4096], path[1024];
-    snprintf(path, sizeof path, "%s/scale_names.json", tu_tmpdir());
-    snprintf(cmd, sizeof cmd,
-             TWO_POCL "%s tests/scenes/tiny.json -q --device pocl,pocl -o %s/scale_names.png "
-                      "--stats-json %s",
-             tu_vbcl, tu_tmpdir(), path);
-    int rc = tu_run(cmd, out, sizeof out);
-    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, out);
-    cJSON *doc = read_json(path);
+    cJSON *doc = two_pocl_stats("tests/scenes/tiny.json --device pocl,pocl", "scale_names");
     if (!doc) return;
     const cJSON *devs = cJSON_GetObjectItemCaseSensitive(doc, "devices");
     CHECK(cJSON_GetArraySize(devs) == 2 && json_num(cJSON_GetArrayItem(devs, 0), "index") == 0 &&
