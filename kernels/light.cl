@@ -364,8 +364,8 @@ VB_INLINE float3 light_cap_at(float2 u, float one_minus_cos, float3 tx, float3 t
 {
     float cos_t = 1.0f - u.x * one_minus_cos;
     float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
-    float phi = 2.0f * VB_PI * u.y;
-    return normalize(tx * (sin_t * cos(phi)) + ty * (sin_t * sin(phi)) + wc * cos_t);
+    float turn = 2.0f * u.y; /* phi / pi: cospi and sinpi reduce it exactly */
+    return normalize(tx * (sin_t * cospi(turn)) + ty * (sin_t * sinpi(turn)) + wc * cos_t);
 }
 
 #ifdef VBCL_HAS_AREA_LIGHTS
