@@ -209,7 +209,9 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
  * light's centre, of half-angle theta with sin theta = r / d, and ends before distance d;
  * an object can stop one only if the cone meets its bounds (light_cone_meets). Where it
  * does, its own triangles are taken, and of its texture only the parts (connected pieces,
- * VbObject.first_elem) whose own bounds the cone meets. The point's own object cannot stop
+ * VbObject.first_elem) whose own bounds the cone meets; an object or part of more than
+ * VB_OBJECT_SET_MAX_TRIS / 2 triangles is kept aside as big instead (a glass ball of
+ * thousands of triangles: only the feelers that meet its bounding sphere walk the grid). The point's own object cannot stop
  * a feeler when it is planar (a feeler is traced only toward the side of the surface it
  * leaves from), nor when it is convex and the feeler leaves from the front of its
  * triangle: all of the object lies behind that triangle's plane; the same holds for the
@@ -242,6 +244,10 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             ((flags & VBCL_OBJECT_PLANAR) || ((flags & VBCL_OBJECT_CONVEX) && sp->front)))
             continue;
         if (!light_cone_meets(&k, ob)) continue;
+        if (ob->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
+            if (!object_set_big(os, i)) return;
+            continue;
+        }
         if (!object_set_add(os, ob->first_tri, ob->ntris)) return;
         if (ob->nelems == 0u) {
             if (!object_set_add(os, ob->first_tex, ob->ntex)) return;
@@ -253,11 +259,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
                 continue;
             if (!light_cone_meets(&k, el)) continue;
             if (el->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
-                if (os->nbig == VB_OBJECT_SET_MAX_BIG) {
-                    os->n = -1;
-                    return;
-                }
-                os->big[os->nbig++] = ob->first_elem + e;
+                if (!object_set_big(os, ob->first_elem + e)) return;
             } else if (!object_set_add(os, el->first_tri, el->ntris)) {
                 return;
             }

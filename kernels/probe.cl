@@ -143,7 +143,8 @@ VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, flo
         int part = -1;
         for (int k = 0; k < os->nbig; k++) {
             __global const VbObject *el = sc->objects + os->big[k];
-            if (q - el->first_tri < el->ntris) part = (int)os->big[k];
+            if (os->big[k] >= sc->f->nobjects && q - el->first_tri < el->ntris)
+                part = (int)os->big[k];
         }
         if (part < 0) {
             closest_test(&rs, org, t, sc->tris, (int)q, all);

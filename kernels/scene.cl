@@ -72,8 +72,9 @@ typedef struct ObjectSet {
     int n;
     uint tris; /* triangles in all */
     uint first[VB_OBJECT_SET_MAX], count[VB_OBJECT_SET_MAX];
-    int nbig; /* records (VbObject: texture parts) of big: a feeler that meets the bounding
-               * sphere of one of them walks the grid, the others test the ranges alone */
+    int nbig; /* records (VbObject: objects of many triangles, their textures included, and
+               * texture parts) of big: a feeler that meets the bounding sphere of one of
+               * them walks the grid, the others test the ranges alone */
     uint big[VB_OBJECT_SET_MAX_BIG];
 } ObjectSet;
 
@@ -140,7 +141,7 @@ VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject
 }
 
 /* What a feeler (org, dir, t) of set os needs: OBJECT_SET_ALONE, its set's triangles alone;
- * OBJECT_SET_GRID, the grid (it meets the bounds of one of the set's big parts);
+ * OBJECT_SET_GRID, the grid (it meets the bounds of one of the set's big objects or parts);
  * OBJECT_SET_BLOCKED, nothing: it passes through the core of a solid big part
  * (VBCL_OBJECT_SOLID) and is stopped there, whatever it crosses before (with transparency,
  * where the feeler starts outside every texture element: tex_free). */
@@ -154,6 +155,7 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
     for (int k = 0; k < os->nbig; k++) {
         __global const VbObject *ob = sc->objects + os->big[k];
         if (!object_segment_meets(ob, org, dir, t)) continue;
+        if (os->big[k] < sc->f->nobjects) return OBJECT_SET_GRID; /* an object, not a part */
 #ifdef VBCL_HAS_TRANSPARENCY
         if (tex_free && (ob->flags & VBCL_OBJECT_SOLID) &&
             object_segment_through_core(ob, org, dir, t))
@@ -189,6 +191,18 @@ VB_INLINE int object_set_add(ObjectSet *os, uint first, uint count)
     }
     os->first[os->n] = first;
     os->count[os->n++] = count;
+    return 1;
+}
+
+/* Adds record rec (an object, its texture included, or a texture part) to the set's big
+ * ones, whose bounds each feeler tests; 0 where there are too many (n = -1: the grid). */
+VB_INLINE int object_set_big(ObjectSet *os, uint rec)
+{
+    if (os->nbig == VB_OBJECT_SET_MAX_BIG) {
+        os->n = -1;
+        return 0;
+    }
+    os->big[os->nbig++] = rec;
     return 1;
 }
 
