@@ -29,6 +29,7 @@
 typedef struct Options {
     const char *scene, *grid, *device, *json;
     int width, height, shadow_samples, repeats, threads, robust, no_cone_test;
+    float subgrid_density; /* 0: the scene's */
 } Options;
 
 enum { KIND_PRIMARY, KIND_SHADOW, KIND_GLASS, KIND_SECONDARY, KIND_COUNT };
@@ -72,6 +73,8 @@ static const char usage[] =
     "  vbcl's rays per second against Embree's on the same triangles and rays, per kind\n"
     "  (primary, shadow, shadow_glass, secondary), medians of interleaved repeats\n"
     "  --grid auto|N|X,Y,Z     the renderer's grid (default: the scene's own)\n"
+    "  --subgrid-density D     sub-cells per triangle of a crowded top cell (default: the\n"
+    "                          scene's, else 2; as vbcl's --subgrid-density)\n"
     "  --width N --height N    camera rays (default: the scene's image size)\n"
     "  --shadow-samples N      feelers per point and light (default: the scene's)\n"
     "  --no-cone-test          vbcl traces every feeler (by default, as in a render, the\n"
@@ -97,6 +100,18 @@ static int int_arg(const char *name, const char *v, int lo, int hi, int *out)
     return 0;
 }
 
+static int float_arg(const char *name, const char *v, float lo, float hi, float *out)
+{
+    char *end;
+    double x = v ? strtod(v, &end) : 0.0;
+    if (!v || *end || !(x >= lo && x <= hi)) {
+        fprintf(stderr, "vbcl-bench-rays: %s: expected a number in %g..%g\n", name, lo, hi);
+        return 2;
+    }
+    *out = (float)x;
+    return 0;
+}
+
 /* Returns -1 to go on, or an exit status. */
 static int parse_args(int argc, char **argv, Options *o)
 {
@@ -114,6 +129,8 @@ static int parse_args(int argc, char **argv, Options *o)
             o->grid = argv[++i];
         else if (!strcmp(a, "--device") && v)
             o->device = argv[++i];
+        else if (!strcmp(a, "--subgrid-density"))
+            rc = float_arg(a, argv[++i], 0.01f, 64.0f, &o->subgrid_density);
         else if (!strcmp(a, "--no-cone-test"))
             o->no_cone_test = 1;
         else if (!strcmp(a, "--json") && v)
@@ -800,6 +817,7 @@ static int bench_open(Bench *b)
     if (o->height) b->s.height = o->height;
     if (o->shadow_samples) b->s.shadow_samples = o->shadow_samples;
     if (o->no_cone_test) b->s.shadow_cone_test = 0;
+    if (o->subgrid_density > 0.0f) b->s.subgrid_density = o->subgrid_density;
     if (o->grid && scene_parse_grid(o->grid, b->s.grid_res)) {
         fprintf(stderr, "vbcl-bench-rays: --grid %s: expected auto, N or NX,NY,NZ\n", o->grid);
         scene_free(&b->s);
