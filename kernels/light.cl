@@ -211,10 +211,10 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
  * does, its own triangles are taken, and of its texture only the parts (connected pieces,
  * VbObject.first_elem) whose own bounds the cone meets; an object or part of more than
  * VB_OBJECT_SET_MAX_TRIS / 2 triangles is kept aside as big instead (a glass ball of
- * thousands of triangles: only the feelers that meet its bounding sphere walk the grid). The point's own object cannot stop
- * a feeler when it is planar (a feeler is traced only toward the side of the surface it
- * leaves from), nor when it is convex and the feeler leaves from the front of its
- * triangle: all of the object lies behind that triangle's plane; the same holds for the
+ * thousands of triangles: only the feelers that meet its bounding sphere walk the grid). The
+ * point's own object cannot stop a feeler when it is planar (a feeler is traced only toward the
+ * side of the surface it leaves from), nor when it is convex and the feeler leaves from the front
+ * of its triangle: all of the object lies behind that triangle's plane; the same holds for the
  * convex part of a texture the point lies on. Margins (1e-5 of the distances, the host's
  * planarity margin) keep float rounding on the safe side: a triangle left out is one no
  * feeler's walk would meet, and the image is the same as with every feeler walked through
