@@ -349,9 +349,9 @@ VB_INLINE float2 light_cap_uv(const CapFeelers *cf, uint i, uint j)
 {
     uint strata = cf->strata;
     if (cf->mode == LIGHT_FEELERS_NET) {
-        uint2 q = vb_sobol2(i * strata + j);
-        return (float2)(vb_unit_float(vb_owen_scramble(q.x, cf->seed_u)),
-                        vb_unit_float(vb_owen_scramble(q.y, cf->seed_v)));
+        uint2 q = vb_sobol2_reversed(i * strata + j);
+        return (float2)(vb_unit_float(vb_owen_scramble_reversed(q.x, cf->seed_u)),
+                        vb_unit_float(vb_owen_scramble_reversed(q.y, cf->seed_v)));
     }
     int jitter = cf->mode == LIGHT_FEELERS_JITTERED;
     uint h = vb_hash(cf->key ^ vb_hash(i * strata + j + 0x9e3779b9u));

@@ -40,12 +40,12 @@ VB_INLINE uint vb_reverse_bits(uint x)
 
 /* Owen's nested scrambling of a coordinate in 32-bit fixed point, keyed by seed (Burley
  * 2020, "Practical hash-based Owen scrambling": the Laine-Karras permutation on the
- * reversed bits). Each digit is flipped by a hash of the digits above it, so a point set
- * that is a (0, m, 2)-net stays one, now randomised. */
-VB_INLINE uint vb_owen_scramble(uint x, uint seed)
+ * reversed bits), the coordinate given with its bits already reversed (xr). Each digit is
+ * flipped by a hash of the digits above it, so a point set that is a (0, m, 2)-net stays
+ * one, now randomised. */
+VB_INLINE uint vb_owen_scramble_reversed(uint xr, uint seed)
 {
-    x = vb_reverse_bits(x);
-    x += seed;
+    uint x = xr + seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
     x ^= x * 0xc7afe638u;
@@ -53,16 +53,19 @@ VB_INLINE uint vb_owen_scramble(uint x, uint seed)
     return vb_reverse_bits(x);
 }
 
-/* Point k of the base-2 (0, 2)-sequence in 32-bit fixed point: van der Corput's radical
- * inverse and Sobol's second dimension. Its first 4^m points are a (0, 2m, 2)-net: one
- * point in each of the 4^m elementary rectangles of every shape (4^m x 1, ..., 1 x 4^m),
- * where n x n jittered strata fill only the n x n squares. */
-VB_INLINE uint2 vb_sobol2(uint k)
+/* Point k of the base-2 (0, 2)-sequence in 32-bit fixed point, each coordinate with its
+ * bits reversed (what vb_owen_scramble_reversed takes, so that no reversal is spent on it):
+ * van der Corput's radical inverse, whose reversal is k itself, and Sobol's second
+ * dimension, the XOR of the direction numbers v_i of k's set bits (v_0 = 2^31,
+ * v_i+1 = v_i ^ v_i >> 1; reversed: r_0 = 1, r_i+1 = r_i ^ r_i << 1). Its first 4^m points
+ * are a (0, 2m, 2)-net: one point in each of the 4^m elementary rectangles of every shape
+ * (4^m x 1, ..., 1 x 4^m), where n x n jittered strata fill only the n x n squares. */
+VB_INLINE uint2 vb_sobol2_reversed(uint k)
 {
-    uint v = 1u << 31, y = 0u;
-    for (uint i = k; i; i >>= 1, v ^= v >> 1)
-        if (i & 1u) y ^= v;
-    return (uint2)(vb_reverse_bits(k), y);
+    uint r = 1u, y = 0u;
+    for (uint i = k; i; i >>= 1, r ^= r << 1)
+        if (i & 1u) y ^= r;
+    return (uint2)(k, y);
 }
 
 #endif

@@ -128,8 +128,8 @@ VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject
         float3 v0 = tri_vertex(sc->tris, (int)k, 0).xyz;
         float3 n = cross(tri_vertex(sc->tris, (int)k, 1).xyz - v0,
                          tri_vertex(sc->tris, (int)k, 2).xyz - v0);
-        float len = length(n);
-        float d0 = dot(n, org - v0) / len, dn = dot(n, dir) / len; /* inside: d0 + s dn <= 0 */
+        /* inside: d0 + s dn <= 0; the crossing -d0 / dn needs no unit normal */
+        float d0 = dot(n, org - v0), dn = dot(n, dir);
         if (dn > 0.0f)
             s1 = fmin(s1, -d0 / dn);
         else if (dn < 0.0f)
@@ -169,6 +169,7 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
                 st = object_hull_stretch(sc, ho, org, dir, t,
                                          1e-5f * (t + vb_max3(fabs(org)) + ho->bound[3]));
             }
+            if (st.x > st.y) continue; /* it misses the host, and so the part inside */
             if (!object_stretch_meets(ob, org, dir, st)) continue;
         }
 #else
