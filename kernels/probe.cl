@@ -173,18 +173,16 @@ VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, flo
  * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
  * bits 0-1 what light_cone_objects says (0: the grid, 1: clear, 2: a set of triangles
  * alone; 3: the point is inside the light, no test), bit 2 set where the set (or clear
- * cone) has big texture parts whose bounds each feeler tests, bit 3 where some feeler met
- * such bounds (and walks the grid, not checked here), bit 4 where some feeler passed
- * through a solid part's core (not traced in a render: its walk through the grid, run
- * here, must let nothing through), bits 5-15 how many of nrays feelers
- * spread over the light's cap (uniform in solid angle, 8 on its rim; those leaving the
- * surface's front only, each to the near side of the sphere) the brute force (or for the
- * blocked ones, the walk) contradicts:
- * for a clear cone, feelers that meet a triangle, every triangle tested; for a set,
- * feelers whose closest hit among the set's triangles (scene_trace_closest_in) is not the
- * closest of all triangles (the same test, ties to the lower index; the big parts' left
- * out, but a feeler that meets one inside its host is wrong), bits 16-31 such a feeler's
- * triangle (clear) or its brute-force hit + 1 (set). */
+ * cone) has big objects or texture parts whose bounds each feeler tests, bit 3 where some feeler
+ * met such bounds (and walks the grid, not checked here), bit 4 where some feeler passed through a
+ * solid part's core (not traced in a render: its walk through the grid, run here, must let nothing
+ * through), bits 5-15 how many of nrays feelers spread over the light's cap (uniform in solid
+ * angle, 8 on its rim; those leaving the surface's front only, each to the near side of the sphere)
+ * the brute force (or for the blocked ones, the walk) contradicts: for a clear cone, feelers that
+ * meet a triangle, every triangle tested; for a set, feelers whose closest hit among the set's
+ * triangles (scene_trace_closest_in) is not the closest of all triangles (the same test, ties to
+ * the lower index; the big parts' left out, but a feeler that meets one inside its host is wrong),
+ * bits 16-31 such a feeler's triangle (clear) or its brute-force hit + 1 (set). */
 __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
                                __global uint *out)
 {

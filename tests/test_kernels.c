@@ -451,7 +451,9 @@ static void test_light_irradiance_closed_form(void)
  * a million such feelers. The test must also find clear cones, planar and convex surfaces'
  * own included. Where it names a few triangles as the only ones in the way, the closest
  * hit among them is every feeler's closest hit of all, the big spheres' triangles aside,
- * which such a feeler may meet only outside the prism (where they change nothing); such
+ * which such a feeler may meet only outside the prism (where they change nothing), and a
+ * feeler kept off the grid beside the sphere or the vase (objects of more than 16 triangles,
+ * whose bounding spheres each feeler tests) must miss them; such
  * sets must also come from points on the texture's spheres (the prism's triangles without
  * the spheres the cone misses). Feelers that pass through the core of a solid sphere,
  * which a render does not trace, must meet that sphere and, where the probe knows their
