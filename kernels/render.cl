@@ -137,6 +137,19 @@ __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
     atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
 }
 
+/* Adds one work item's shading counts (its feelers and their walks) to the frame counters. */
+VB_INLINE void shade_flush_counts(__global uint *counters, const TraceCount *tc,
+                                  const ShadowCount *shc)
+{
+    atomic_add(&counters[VBCL_COUNT_SHADOW], shc->traced);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc->skipped);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_UNNEEDED], shc->unneeded);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_CLEAR], shc->clear);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_BLOCKED], shc->blocked);
+    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc->steps);
+    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc->tests);
+}
+
 /* rays, hits, media -> radiance (rgb + 1 per ray): the k_local term at each primary hit
  * with shadow feelers, or the background for rays that left the scene. */
 __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
@@ -171,13 +184,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0, 0, 0, 0};
         col = weight * light_shade_local(&sc, &sp, &tc, &shc);
-        atomic_add(&counters[VBCL_COUNT_SHADOW], shc.traced);
-        atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc.skipped);
-        atomic_add(&counters[VBCL_COUNT_SHADOW_UNNEEDED], shc.unneeded);
-        atomic_add(&counters[VBCL_COUNT_SHADOW_CLEAR], shc.clear);
-        atomic_add(&counters[VBCL_COUNT_SHADOW_BLOCKED], shc.blocked);
-        atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc.steps);
-        atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
+        shade_flush_counts(counters, &tc, &shc);
     }
     vstore4((float4)(col, 1.0f), i, radiance);
 }
@@ -235,13 +242,7 @@ VB_INLINE void tree_flush_counts(__global uint *counters, const TreeCount *cnt,
 #endif
     for (int d = 1; d < VBCL_COUNT_DEPTH_BINS; d++)
         if (cnt->by_depth[d]) atomic_add(&counters[VBCL_COUNT_DEPTH0 + d], cnt->by_depth[d]);
-    atomic_add(&counters[VBCL_COUNT_SHADOW], shc->traced);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc->skipped);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_UNNEEDED], shc->unneeded);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_CLEAR], shc->clear);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_BLOCKED], shc->blocked);
-    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc->steps);
-    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc->tests);
+    shade_flush_counts(counters, tc, shc);
 }
 
 /* rays, hits, media -> radiance += the k_global term: the reflected and transmitted
