@@ -114,6 +114,12 @@ typedef struct LightShading {
     float d2, d;   /* its squared length and length */
 } LightShading;
 
+/* The cosine N.H below which the Blinn-Phong lobe of exponent n, (N.H)^n, is under 1e-4. */
+VB_INLINE float light_nh_min(float exponent)
+{
+    return exp(-9.2103f / fmax(exponent, 1e-3f));
+}
+
 /* The terms of the BRDF at sp for material m (its diffuse colour `diffuse`, pattern
  * included) under a light whose centre is c. */
 VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 diffuse,
@@ -130,7 +136,7 @@ VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 d
     ls.specular = vb_max3(ls.ks) > 0.0f;
     ls.exponent = m->exponent;
     ls.spec_norm = (m->exponent + 8.0f) * (1.0f / (8.0f * VB_PI));
-    ls.nh_min = exp(-9.2103f / fmax(m->exponent, 1e-3f));
+    ls.nh_min = light_nh_min(m->exponent);
 #else
     (void)m;
 #endif
@@ -308,6 +314,35 @@ VB_INLINE int light_brdf_responds(const LightShading *ls, const ShadePoint *sp, 
 #endif
 }
 
+/* Whether no direction w of the cap of half-angle alpha (sin alpha = sin_a) around wc can
+ * reach the specular lobe (N.H > nh_min, light_brdf_responds), so that a point without a
+ * diffuse term needs none of its feelers. w is the mirror image of wo about the half
+ * vector H, and the mirror direction m is wo's about N; reflecting about H after N is a
+ * turn by twice the angle between them, so angle(w, m) <= 2 angle(H, N). Every w lies
+ * within alpha of wc: if wc is farther than alpha + 2 acos(nh_min) from m, N.H < nh_min for
+ * all of them. Kept for lobes narrower than 45 degrees (2 acos(nh_min) < 90 degrees), with
+ * a margin of 1e-4 in the cosine for float rounding. Without a specular term nothing
+ * responds at all. */
+VB_INLINE int light_lobe_misses_cap(const LightShading *ls, const ShadePoint *sp, float3 wc,
+                                    float sin_a)
+{
+#ifdef VBCL_HAS_SPECULAR
+    if (!ls->specular) return 1;
+    float cos_2t = 2.0f * ls->nh_min * ls->nh_min - 1.0f;
+    if (cos_2t <= 0.0f) return 0;
+    float sin_2t = 2.0f * ls->nh_min * sqrt(fmax(0.0f, 1.0f - ls->nh_min * ls->nh_min));
+    float cos_a = sqrt(fmax(0.0f, 1.0f - sin_a * sin_a));
+    float3 m = 2.0f * dot(sp->ns, sp->wo) * sp->ns - sp->wo;
+    return dot(wc, m) < cos_a * cos_2t - sin_a * sin_2t - 1e-4f;
+#else
+    (void)ls;
+    (void)sp;
+    (void)wc;
+    (void)sin_a;
+    return 1;
+#endif
+}
+
 /* How a point's feelers are placed, from the frame's flags: LIGHT_FEELERS_NET for jittered
  * feelers of a power-of-two side (the host decides, VBCL_FRAME_NET_FEELERS), _JITTERED
  * for other jittered ones, _FIXED at the strata's centres. */
@@ -390,6 +425,10 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     float sin_max = r / ls->d;
     if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
         sc->skipped += strata * strata;
+        return (float3)(0.0f);
+    }
+    if (!ls->diffuse && light_lobe_misses_cap(ls, sp, wc, sin_max)) {
+        sc->unneeded += strata * strata;
         return (float3)(0.0f);
     }
     float omega = light_cap_solid_angle(r, ls->d);

@@ -276,6 +276,39 @@ __kernel void probe_cap_uv(uint strata, uint key0, uint nkeys, int mode, __globa
             vstore2(light_cap_uv(&cf, i, j), (k * strata + i) * strata + j, out);
 }
 
+#ifdef VBCL_HAS_SPECULAR
+/* For the lobe test (light_lobe_misses_cap): each case of 12 floats (ns, wo, wc, sin alpha,
+ * the exponent, two unused) -> 3 floats: 1 where the test lets a point without a diffuse
+ * term skip its feelers, the largest N.H over 65 x 64 directions of the cap (its rim
+ * included, placed as light_cap_at places feelers), and nh_min. */
+__kernel void probe_lobe_cap(__global const float *cases, int n, __global float *out)
+{
+    int i = get_global_id(0);
+    if (i >= n) return;
+    __global const float *c = cases + 12 * i;
+    ShadePoint sp;
+    sp.ns = normalize(vload3(0, c));
+    sp.wo = normalize(vload3(1, c));
+    float3 wc = normalize(vload3(2, c));
+    float sin_a = c[9];
+    LightShading ls;
+    ls.diffuse = 0;
+    ls.specular = 1;
+    ls.nh_min = light_nh_min(c[10]);
+    float one_minus_cos = light_cap_solid_angle(sin_a, 1.0f) * (1.0f / (2.0f * VB_PI));
+    float3 tx, ty;
+    vb_frame(wc, &tx, &ty);
+    float best = -1.0f;
+    for (int a = 0; a <= 64; a++)
+        for (int b = 0; b < 64; b++) {
+            float3 w = light_cap_at((float2)((float)a / 64.0f, (float)b / 64.0f), one_minus_cos, tx,
+                                    ty, wc);
+            best = fmax(best, dot(sp.ns, normalize(w + sp.wo)));
+        }
+    vstore3((float3)((float)light_lobe_misses_cap(&ls, &sp, wc, sin_a), best, ls.nh_min), i, out);
+}
+#endif
+
 /* shear constants and single-triangle tests for the watertightness checks:
  * rays x triangles -> 1 if hit. */
 __kernel void probe_hit_matrix(__global const VbTriangle *tris, uint ntris,

@@ -811,6 +811,70 @@ static void test_failed_build_prints_log_and_options(void)
     clu_error_clear();
 }
 
+/* The lobe test (light_lobe_misses_cap) against brute force: for 20,000 random points
+ * (normal, viewer, direction to the light's centre at 0 – 1.2 rad from the mirror
+ * direction, cap half-angles of sin 0.002 – 0.4, exponents 20 to 2000), wherever the test
+ * lets a point without a diffuse term skip its feelers, no direction of 65 x 64 spread over
+ * the cap (its rim included) has N.H above nh_min; and the test is not idle: it skips at
+ * least half of the points whose cap the brute force finds outside the lobe. Exponent 20
+ * (a lobe wider than 45 degrees) is never skipped. */
+static void test_light_lobe_cap(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{" CAM "\"materials\": {\"m\": {\"diffuse\": [0, 0, 0], "
+                          "\"specular\": [1, 1, 1], \"exponent\": 300}}, \"objects\": "
+                          "[{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    enum { N = 20000 };
+    static float cases[N * 12], out[N * 3];
+    const float exponents[] = {20.0f, 50.0f, 300.0f, 2000.0f};
+    unsigned seed = 777;
+    for (int i = 0; i < N; i++) {
+        float *c = cases + 12 * i;
+        vec3 n = v3_norm(v3(frand(&seed) - 0.5f, frand(&seed) - 0.5f, frand(&seed) - 0.5f));
+        vec3 wo = v3_norm(v3(frand(&seed) - 0.5f, frand(&seed) - 0.5f, frand(&seed) - 0.5f));
+        if (v3_dot(n, wo) < 0.0f) wo = v3_scale(wo, -1.0f);
+        vec3 m = v3_sub(v3_scale(n, 2.0f * v3_dot(n, wo)), wo);
+        vec3 p =
+            v3_norm(v3_cross(m, v3(frand(&seed) - 0.5f, frand(&seed) - 0.5f, frand(&seed) - 0.5f)));
+        float phi = 1.2f * frand(&seed);
+        vec3 wc = v3_add(v3_scale(m, cosf(phi)), v3_scale(p, sinf(phi)));
+        const vec3 v[3] = {n, wo, wc};
+        for (int k = 0; k < 3; k++) c[3 * k] = v[k].x, c[3 * k + 1] = v[k].y, c[3 * k + 2] = v[k].z;
+        c[9] = 0.002f + 0.398f * frand(&seed);
+        c[10] = exponents[i % 4];
+        c[11] = 0.0f;
+    }
+    cl_mem mc = buffer(cases, sizeof cases), mo = buffer(NULL, sizeof out);
+    int n = N;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *args[] = {&mc, &n, &mo};
+    int rc = run_kernel(fx.r.program, "probe_lobe_cap", N, 3, sz, args);
+    read_buffer(mo, out, sizeof out);
+    clReleaseMemObject(mc);
+    clReleaseMemObject(mo);
+    fixture_close(&fx);
+    if (rc) return;
+    int wrong = 0, skipped = 0, outside = 0, found = 0, wide = 0;
+    for (int i = 0; i < N; i++) {
+        const float *o = out + 3 * i;
+        int skip = o[0] != 0.0f, out_of_lobe = o[1] <= o[2];
+        wrong += skip && !out_of_lobe;
+        skipped += skip;
+        outside += out_of_lobe;
+        found += skip && out_of_lobe;
+        wide += skip && i % 4 == 0;
+    }
+    fprintf(stderr,
+            "    %d of %d caps skipped; brute force: %d outside the lobe, %d of them "
+            "skipped; %d wrongly\n",
+            skipped, N, outside, found, wrong);
+    CHECK(wrong == 0 && wide == 0 && outside > N / 10 && 2 * found >= outside,
+          "%d caps skipped that reach the lobe, %d of exponent 20; %d of %d outside the lobe "
+          "skipped",
+          wrong, wide, found, outside);
+}
+
 void suite_kernels(void)
 {
     RUN_TEST(test_failed_build_prints_log_and_options);
@@ -820,6 +884,7 @@ void suite_kernels(void)
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);
     RUN_TEST(test_light_feelers_net);
+    RUN_TEST(test_light_lobe_cap);
     RUN_TEST(test_light_cone_brute);
     RUN_TEST(test_light_cone_flag);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
