@@ -229,6 +229,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
                                   float r, ObjectSet *os)
 {
     os->n = -1;
+    os->sole = -1;
     if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return;
     os->n = 0;
     os->tris = 0u;
@@ -243,6 +244,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
     k.cos_t = sqrt(fmax(0.0f, 1.0f - k.sin_t * k.sin_t));
     k.reach = vb_max3(fabs(k.o)) + vb_max3(fabs(k.c)) + r;
     uint tri = (uint)sp->tri; /* -1: no part's triangle */
+    int owners = -1; /* the one object the cone meets, if a convex host; -2: another case */
     for (uint i = 0; i < scn->f->nobjects; i++) {
         __global const VbObject *ob = scn->objects + i;
         uint flags = ob->flags;
@@ -250,6 +252,10 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             ((flags & VBCL_OBJECT_PLANAR) || ((flags & VBCL_OBJECT_CONVEX) && sp->front)))
             continue;
         if (!light_cone_meets(&k, ob)) continue;
+        owners = owners == -1 && (flags & VBCL_OBJECT_HOST) &&
+                         (flags & (VBCL_OBJECT_CONVEX | VBCL_OBJECT_HULL))
+                     ? (int)i
+                     : -2;
         if (ob->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
             if (!object_set_big(os, i)) return;
             continue;
@@ -271,6 +277,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             }
         }
     }
+    os->sole = owners;
 }
 
 /* What feeler (w, t) from origin lets through, where the point's cone gave set os (and
@@ -295,6 +302,7 @@ VB_INLINE float3 light_feeler_decided(const DevScene *scn, const ShadePoint *sp,
     sc->traced++;
     ObjectSet grid;
     grid.n = -1;
+    grid.sole = os->sole; /* the set is whole: only a big record's bounds send it to the grid */
     return light_feeler(scn, sp, need == OBJECT_SET_GRID ? &grid : os, origin, w, t, tc);
 }
 

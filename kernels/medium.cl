@@ -153,7 +153,9 @@ VB_INLINE float3 medium_interface_transmit(const DevScene *sc, float3 d, float3 
  * distance tmax, starting in medium `state`: multiplied by the transmitted fraction of
  * every interface it crosses (weighted by that surface's k_global) and by absorption along
  * the way; zero at an opaque surface. Feelers are not bent. Only the objects of os can be
- * met (os->n < 0: any object, through the grid). */
+ * met (os->n < 0: any object, through the grid); a feeler that crosses out of os's sole
+ * convex host meets nothing more (light_cone_objects) and only the outer medium's
+ * absorption is left. */
 VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, const ObjectSet *os, float3 org,
                                              float3 dir, float tmax, VbMedium state, int band,
                                              TraceCount *tc)
@@ -177,8 +179,10 @@ VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, const ObjectSet
                      medium_interface_transmit(sc, dir, ng, c.mat_before, c.mat_after, band);
         }
         if (vb_max3(trans) < 1e-7f) return (float3)(0.0f); /* nothing gets through */
+        int left_sole = os->sole >= 0 && state.host == os->sole && c.after.host < 0;
         state = c.after;
         left -= seg;
+        if (left_sole) return trans * medium_absorb(sc, medium_material(sc, state), left);
         o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
     }
     return (float3)(0.0f);

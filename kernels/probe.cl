@@ -123,6 +123,7 @@ VB_INLINE int probe_blocked_feeler(const DevScene *sc, const ShadePoint *sp, con
     if (plain) {
         ObjectSet grid;
         grid.n = -1;
+        grid.sole = -1;
         TraceCount tw = {0, 0};
         v = medium_shadow_transmittance(sc, &grid, org, w, t, sp->medium, -1, &tw);
     }
@@ -168,6 +169,35 @@ VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, flo
     return 0xffffffffu;
 }
 
+/* The shading point of a cone probe's case (probe_cone_brute's layout) in medium m. */
+VB_INLINE ShadePoint probe_case_point(__global const float *cs, VbMedium m)
+{
+    ShadePoint sp;
+    sp.p = vload3(0, cs);
+    sp.object = (int)cs[3];
+    sp.tri = (int)cs[13];
+    sp.ng = normalize(vload3(0, cs + 4));
+    sp.front = cs[7] > 0.0f;
+    sp.ns = sp.ng;
+    sp.wo = sp.ng;
+    sp.material = 0;
+    sp.key = 0;
+    sp.medium = m;
+    sp.scale = cs[12];
+    sp.band = -1;
+    return sp;
+}
+
+/* Feeler k of case i over the light's cap (frame tx, ty, wc): uniform in solid angle, the
+ * first 8 on its rim. */
+VB_INLINE float3 probe_cap_feeler(int i, int k, float one_minus_cos, float3 tx, float3 ty,
+                                  float3 wc)
+{
+    uint h = vb_hash((uint)i * 7919u + (uint)k);
+    float2 u = (float2)(k < 8 ? 1.0f : vb_unit_float(h), vb_unit_float(vb_hash(h ^ 0x5bd1e995u)));
+    return light_cap_at(u, one_minus_cos, tx, ty, wc);
+}
+
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
  * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
  * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
@@ -190,19 +220,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     if (i >= ncases) return;
     DevScene sc = DEV_SCENE;
     __global const float *cs = cases + 16 * i;
-    ShadePoint sp;
-    sp.p = vload3(0, cs);
-    sp.object = (int)cs[3];
-    sp.tri = (int)cs[13];
-    sp.ng = normalize(vload3(0, cs + 4));
-    sp.front = cs[7] > 0.0f;
-    sp.ns = sp.ng;
-    sp.wo = sp.ng;
-    sp.material = 0;
-    sp.key = 0;
-    sp.medium = f->camera_medium;
-    sp.scale = cs[12];
-    sp.band = -1;
+    ShadePoint sp = probe_case_point(cs, f->camera_medium);
     float3 c = vload3(0, cs + 8);
     float r = cs[11];
     LightShading ls = light_shading_make(sc.materials, (float3)(0.0f), &sp, c);
@@ -219,10 +237,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
         vb_frame(wc, &tx, &ty);
         float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
         for (int k = 0; k < nrays; k++) {
-            uint h = vb_hash((uint)i * 7919u + (uint)k);
-            float2 u = (float2)(k < 8 ? 1.0f : vb_unit_float(h), /* 8 feelers on the rim */
-                                vb_unit_float(vb_hash(h ^ 0x5bd1e995u)));
-            float3 w = light_cap_at(u, one_minus_cos, tx, ty, wc);
+            float3 w = probe_cap_feeler(i, k, one_minus_cos, tx, ty, wc);
             if (dot(sp.ng, w) <= 0.0f) continue;
             float b = dot(w, ls.to_c);
             float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
@@ -263,6 +278,93 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     out[i] = kind | (kind != 0u && os.nbig > 0 ? 4u : 0u) | (big > 0u ? 8u : 0u) |
              (blocked > 0u ? 16u : 0u) | min(wrong, 2047u) << 5 | which << 16;
 }
+
+#ifdef VBCL_HAS_TRANSPARENCY
+/* medium_shadow_transmittance as it was before ObjectSet.sole: every crossing followed to
+ * the light. The reference of probe_sole_exit. */
+VB_INLINE float3 probe_transmittance_plain(const DevScene *sc, const ObjectSet *os, float3 org,
+                                           float3 dir, float tmax, VbMedium state)
+{
+    float3 trans = (float3)(1.0f), o = org;
+    float left = tmax;
+    TraceCount tc = {0, 0};
+    for (int guard = 0; guard < 1024; guard++) {
+        uint mb = medium_material(sc, state);
+        VbHit h = scene_trace_closest_in(sc, os, o, dir, left, &tc);
+        if (h.tri < 0) return trans * medium_absorb(sc, mb, left);
+        float3 p = tri_point(sc->tris, h);
+        float seg = fmax(0.0f, dot(p - o, dir));
+        trans *= medium_absorb(sc, mb, seg);
+        Crossing c = medium_cross(sc, h.tri, dir, state);
+        float3 ng = tri_normal(sc->tris, h.tri);
+        if (c.interface) {
+            if (sc->materials[c.surface].k_global <= 0.0f) return (float3)(0.0f);
+            trans *= sc->materials[c.surface].k_global *
+                     medium_interface_transmit(sc, dir, ng, c.mat_before, c.mat_after, -1);
+        }
+        if (vb_max3(trans) < 1e-7f) return (float3)(0.0f);
+        state = c.after;
+        left -= seg;
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
+    }
+    return (float3)(0.0f);
+}
+
+/* The sole host (ObjectSet.sole) against following every crossing: cases as
+ * probe_cone_brute's, each point in the medium of host cs[14] (-1: the camera's) -> out:
+ * bit 0 where the cone's set belongs to one convex host, bits 1-15 how many of nrays
+ * feelers over the light's cap get another amount through as a render traces them (the
+ * set's triangles alone, or the grid where a big part's bounds are met; light_feeler_decided)
+ * than with every crossing followed (probe_transmittance_plain, the same triangles), bits
+ * 16-31 how many feelers start inside the sole host and get light through (each has left
+ * it: the walk stopped there). */
+__kernel void probe_sole_exit(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
+                              __global uint *out)
+{
+    int i = get_global_id(0);
+    if (i >= ncases) return;
+    DevScene sc = DEV_SCENE;
+    __global const float *cs = cases + 16 * i;
+    VbMedium m = f->camera_medium;
+    if (cs[14] >= 0.0f) {
+        m.host = (int)cs[14];
+        m.tex_counts = 0u;
+    }
+    ShadePoint sp = probe_case_point(cs, m);
+    float3 c = vload3(0, cs + 8);
+    float r = cs[11];
+    LightShading ls = light_shading_make(sc.materials, (float3)(0.0f), &sp, c);
+    out[i] = 0u;
+    if (ls.d <= r * 1.0001f) return;
+    ObjectSet os;
+    light_cone_objects(&sc, &sp, &ls, r, &os);
+    float3 wc = ls.to_c / ls.d, tx, ty;
+    vb_frame(wc, &tx, &ty);
+    float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
+    ObjectSet grid;
+    grid.n = -1;
+    uint wrong = 0u, exits = 0u;
+    for (int k = 0; k < nrays; k++) {
+        float3 w = probe_cap_feeler(i, k, one_minus_cos, tx, ty, wc);
+        if (dot(sp.ng, w) <= 0.0f) continue;
+        float b = dot(w, ls.to_c);
+        float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
+        int need = os.n >= 0 && os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
+                                                                sp.medium.tex_counts == 0u)
+                                            : (os.n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
+        if (need == OBJECT_SET_BLOCKED || (need == OBJECT_SET_ALONE && os.n == 0)) continue;
+        TraceCount tc = {0, 0};
+        ShadowCount shc = {0, 0, 0, 0, 0};
+        float3 fast = light_feeler_decided(&sc, &sp, &os, ls.origin, w, t_light,
+                                           sp.medium.tex_counts == 0u, &tc, &shc);
+        float3 ref = probe_transmittance_plain(&sc, need == OBJECT_SET_GRID ? &grid : &os,
+                                               ls.origin, w, t_light, sp.medium);
+        wrong += any(fast != ref) ? 1u : 0u;
+        exits += os.sole >= 0 && sp.medium.host == os.sole && vb_max3(ref) > 0.0f;
+    }
+    out[i] = (os.sole >= 0 ? 1u : 0u) | min(wrong, 32767u) << 1 | min(exits, 65535u) << 16;
+}
+#endif
 
 /* The feelers' (u1, u2) of light_cap_uv (mode LIGHT_FEELERS_*) for keys key0 .. key0 +
  * nkeys - 1: strata^2 pairs per key, row-major (i, j). */
