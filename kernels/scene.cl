@@ -76,8 +76,9 @@ typedef struct ObjectSet {
                * texture parts) of big: a feeler that meets the bounding sphere of one of
                * them walks the grid, the others test the ranges alone */
     uint big[VB_OBJECT_SET_MAX_BIG];
-    int sole; /* a convex host (its texture inside it) that all the set holds, ranges and big
-               * records, belongs to, or -1: a feeler that leaves it meets nothing more */
+    int sole; /* the host that all the set holds (ranges and big records) belongs to, where
+               * its own triangles bound a convex volume (VBCL_OBJECT_CONVEX or _HULL; its
+               * texture may reach out), or -1: a feeler that leaves it meets nothing more */
 } ObjectSet;
 
 /* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
