@@ -120,6 +120,14 @@ VB_INLINE float light_nh_min(float exponent)
     return exp(-9.2103f / fmax(exponent, 1e-3f));
 }
 
+/* The distance along unit w from the point of ls to the near side of the light sphere of
+ * radius r (w a direction of the light's cap: the line meets the sphere). */
+VB_INLINE float light_sphere_near(const LightShading *ls, float3 w, float r)
+{
+    float b = dot(w, ls->to_c);
+    return b - sqrt(fmax(0.0f, b * b - (ls->d2 - r * r)));
+}
+
 /* The terms of the BRDF at sp for material m (its diffuse colour `diffuse`, pattern
  * included) under a light whose centre is c. */
 VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 diffuse,
@@ -464,10 +472,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                 sc->unneeded++;
                 continue;
             }
-            /* distance to the near side of the light sphere along w */
-            float b = dot(w, ls->to_c);
-            float disc = fmax(0.0f, b * b - (ls->d2 - r * r));
-            float t_light = b - sqrt(disc);
+            float t_light = light_sphere_near(ls, w, r);
             float3 vis =
                 light_feeler_decided(scn, sp, &os, ls->origin, w, t_light, tex_free, tc, sc);
             if (vb_max3(vis) <= 0.0f) continue;

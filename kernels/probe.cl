@@ -188,14 +188,28 @@ VB_INLINE ShadePoint probe_case_point(__global const float *cs, VbMedium m)
     return sp;
 }
 
-/* Feeler k of case i over the light's cap (frame tx, ty, wc): uniform in solid angle, the
- * first 8 on its rim. */
-VB_INLINE float3 probe_cap_feeler(int i, int k, float one_minus_cos, float3 tx, float3 ty,
-                                  float3 wc)
+/* The cap of the light (radius r) that a cone probe's point sees (ls): its frame and
+ * 1 - cos of its half-angle, as light_reflect_area makes them. */
+typedef struct ProbeCap {
+    float3 wc, tx, ty;
+    float one_minus_cos;
+} ProbeCap;
+
+VB_INLINE ProbeCap probe_cap_make(const LightShading *ls, float r)
+{
+    ProbeCap cap;
+    cap.wc = ls->to_c / ls->d;
+    vb_frame(cap.wc, &cap.tx, &cap.ty);
+    cap.one_minus_cos = light_cap_solid_angle(r, ls->d) * (1.0f / (2.0f * VB_PI));
+    return cap;
+}
+
+/* Feeler k of case i over the cap: uniform in solid angle, the first 8 on its rim. */
+VB_INLINE float3 probe_cap_feeler(const ProbeCap *cap, int i, int k)
 {
     uint h = vb_hash((uint)i * 7919u + (uint)k);
     float2 u = (float2)(k < 8 ? 1.0f : vb_unit_float(h), vb_unit_float(vb_hash(h ^ 0x5bd1e995u)));
-    return light_cap_at(u, one_minus_cos, tx, ty, wc);
+    return light_cap_at(u, cap->one_minus_cos, cap->tx, cap->ty, cap->wc);
 }
 
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
@@ -233,14 +247,11 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     uint kind = os.n == 0 ? 1u : os.n > 0 ? 2u : 0u;
     uint wrong = 0u, which = 0u, big = 0u, blocked = 0u;
     if (kind != 0u) {
-        float3 wc = ls.to_c / ls.d, tx, ty;
-        vb_frame(wc, &tx, &ty);
-        float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
+        ProbeCap cap = probe_cap_make(&ls, r);
         for (int k = 0; k < nrays; k++) {
-            float3 w = probe_cap_feeler(i, k, one_minus_cos, tx, ty, wc);
+            float3 w = probe_cap_feeler(&cap, i, k);
             if (dot(sp.ng, w) <= 0.0f) continue;
-            float b = dot(w, ls.to_c);
-            float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
+            float t_light = light_sphere_near(&ls, w, r);
             int need = os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
                                                        sp.medium.tex_counts == 0u)
                                    : OBJECT_SET_ALONE;
@@ -338,17 +349,14 @@ __kernel void probe_sole_exit(SCENE_KERNEL_ARGS __global const float *cases, int
     if (ls.d <= r * 1.0001f) return;
     ObjectSet os;
     light_cone_objects(&sc, &sp, &ls, r, &os);
-    float3 wc = ls.to_c / ls.d, tx, ty;
-    vb_frame(wc, &tx, &ty);
-    float one_minus_cos = light_cap_solid_angle(r, ls.d) * (1.0f / (2.0f * VB_PI));
+    ProbeCap cap = probe_cap_make(&ls, r);
     ObjectSet grid;
     grid.n = -1;
     uint wrong = 0u, exits = 0u;
     for (int k = 0; k < nrays; k++) {
-        float3 w = probe_cap_feeler(i, k, one_minus_cos, tx, ty, wc);
+        float3 w = probe_cap_feeler(&cap, i, k);
         if (dot(sp.ng, w) <= 0.0f) continue;
-        float b = dot(w, ls.to_c);
-        float t_light = b - sqrt(fmax(0.0f, b * b - (ls.d2 - r * r)));
+        float t_light = light_sphere_near(&ls, w, r);
         int need = os.n >= 0 && os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
                                                                 sp.medium.tex_counts == 0u)
                                             : (os.n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);

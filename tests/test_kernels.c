@@ -493,6 +493,32 @@ static void cone_cases(const Fixture *fx, float *cases, int ncases, unsigned see
     }
 }
 
+/* Runs cone probe `kernel` (probe_cone_brute's arguments) on ncases random cases
+ * (cone_cases with seed), nrays feelers each; returns its output per case (malloc'd; NULL,
+ * a failed check, when out of memory) and the cases in *cases_out. */
+static unsigned *run_cone_probe(Fixture *fx, const char *kernel, int ncases, int nrays,
+                                unsigned seed, float **cases_out)
+{
+    float *cases = calloc((size_t)ncases * 16, sizeof(float));
+    unsigned *out = calloc((size_t)ncases, sizeof(unsigned));
+    *cases_out = cases;
+    if (!cases || !out) {
+        CHECK(0, "out of memory for %d cases", ncases);
+        free(out);
+        return NULL;
+    }
+    cone_cases(fx, cases, ncases, seed);
+    cl_mem mc = buffer(cases, sizeof(float) * 16 * (size_t)ncases),
+           mo = buffer(NULL, sizeof(unsigned) * (size_t)ncases);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(int), sizeof(cl_mem)};
+    const void *vals[] = {&mc, &ncases, &nrays, &mo};
+    fixture_run_probe(fx, kernel, (size_t)ncases, 4, sz, vals);
+    read_buffer(mo, out, sizeof(unsigned) * (size_t)ncases);
+    clReleaseMemObject(mc);
+    clReleaseMemObject(mo);
+    return out;
+}
+
 /* The shadow cone test (light_cone_objects) against brute force: points on every kind of
  * surface (a floor and a tilted wall: planar; a box, a prism, a sphere: convex; a vase:
  * neither; a glass prism with a texture of bombed spheres, some reaching out of it, each
@@ -537,16 +563,13 @@ static void test_light_cone_brute(void)
         return;
     enum { CASES = 16384, RAYS = 128 };
     const Mesh *m = &fx.s.mesh;
-    float *cases = calloc((size_t)CASES * 16, sizeof(float));
-    unsigned *out = calloc(CASES, sizeof(unsigned));
-    if (cases) cone_cases(&fx, cases, CASES, 99);
-    cl_mem mc = buffer(cases, sizeof(float) * 16 * CASES),
-           mo = buffer(NULL, sizeof(unsigned) * CASES);
-    int ncases = CASES, nrays = RAYS;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(int), sizeof(cl_mem)};
-    const void *vals[] = {&mc, &ncases, &nrays, &mo};
-    fixture_run_probe(&fx, "probe_cone_brute", CASES, 4, sz, vals);
-    read_buffer(mo, out, sizeof(unsigned) * CASES);
+    float *cases;
+    unsigned *out = run_cone_probe(&fx, "probe_cone_brute", CASES, RAYS, 99, &cases);
+    if (!out) {
+        free(cases);
+        fixture_close(&fx);
+        return;
+    }
     long count[4] = {0, 0, 0, 0}, wrong[4] = {0, 0, 0, 0}, own_clear = 0, tex_sets = 0;
     long big_sets = 0, big_met = 0, blocked = 0;
     for (int i = 0; i < CASES; i++) {
@@ -584,8 +607,6 @@ static void test_light_cone_brute(void)
           "too few cones to test: %ld clear (%ld on planar or convex objects), %ld sets (%ld from "
           "texture points, %ld with big parts, %ld with feelers meeting them, %ld through a core)",
           count[1], own_clear, count[2], tex_sets, big_sets, big_met, blocked);
-    clReleaseMemObject(mc);
-    clReleaseMemObject(mo);
     free(cases);
     free(out);
     fixture_close(&fx);
@@ -627,16 +648,13 @@ static void test_light_sole_host(void)
             " \"transform\": {\"translate\": [2.5, 0, -1.5]}}]}"))
         return;
     enum { CASES = 16384, RAYS = 128 };
-    float *cases = calloc((size_t)CASES * 16, sizeof(float));
-    unsigned *out = calloc(CASES, sizeof(unsigned));
-    if (cases) cone_cases(&fx, cases, CASES, 4242);
-    cl_mem mc = buffer(cases, sizeof(float) * 16 * CASES),
-           mo = buffer(NULL, sizeof(unsigned) * CASES);
-    int ncases = CASES, nrays = RAYS;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(int), sizeof(cl_mem)};
-    const void *vals[] = {&mc, &ncases, &nrays, &mo};
-    fixture_run_probe(&fx, "probe_sole_exit", CASES, 4, sz, vals);
-    read_buffer(mo, out, sizeof(unsigned) * CASES);
+    float *cases;
+    unsigned *out = run_cone_probe(&fx, "probe_sole_exit", CASES, RAYS, 4242, &cases);
+    if (!out) {
+        free(cases);
+        fixture_close(&fx);
+        return;
+    }
     long sole = 0, wrong = 0, exits = 0;
     for (int i = 0; i < CASES; i++) {
         unsigned nb = (out[i] >> 1) & 32767u;
@@ -658,8 +676,6 @@ static void test_light_sole_host(void)
     CHECK(wrong == 0, "%ld feelers get another amount through with the sole host", wrong);
     CHECK(sole > CASES / 20 && exits > 10000, "too few cases: %ld sole hosts, %ld feelers leaving",
           sole, exits);
-    clReleaseMemObject(mc);
-    clReleaseMemObject(mo);
     free(cases);
     free(out);
     fixture_close(&fx);
