@@ -48,9 +48,9 @@ static void print_setup(FILE *f, const StatsFrame *fr)
             g->tris_per_nonempty_mean, g->refinements);
     fprintf(f,
             "sub-grids   %u of the top cells (%s), %u leaves (sub-cells and lists), %u triangle "
-            "references, at most %u in one leaf, build %.1f ms\n",
+            "references (%zu quads), at most %u in one leaf, build %.1f ms\n",
             g->subgrids, s->subgrid_res[0] ? "given" : "auto", g->nleaves, g->nleaf_refs,
-            g->tris_per_leaf_max, g->leaves_ms);
+            grid_leaf_quads(g, s->tri_tag, VBCL_TAG_TEXTURE), g->tris_per_leaf_max, g->leaves_ms);
 }
 
 /* ray trees, energy, dispersion, rays by depth (scenes with dielectrics) */
@@ -240,6 +240,7 @@ static void json_grid(cJSON *root, const StatsFrame *fr, int *ok)
     num(o, "subgrids", g->subgrids, ok);
     num(o, "leaves", g->nleaves, ok);
     num(o, "leaf_refs", g->nleaf_refs, ok);
+    num(o, "leaf_quads", (double)grid_leaf_quads(g, fr->scene->tri_tag, VBCL_TAG_TEXTURE), ok);
     num(o, "tris_per_leaf_max", g->tris_per_leaf_max, ok);
     num(o, "leaves_build_ms", g->leaves_ms, ok);
 }

@@ -189,15 +189,90 @@ VB_INLINE int any_test(const RayShear *rs, float tmax, __global const VbTriangle
                          tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
 }
 
+/* Coordinate k (0, 1, 2: x, y, z) of four points, one per lane. */
+VB_INLINE float4 vb_comp4(float4 x, float4 y, float4 z, uint k)
+{
+    return k == 0u ? x : (k == 1u ? y : z);
+}
+
+/* Vertex k of a quad's four triangles through the ray's shear: ray_shear_apply lane by
+ * lane, with the same operations in the same order (contraction is off), so every value
+ * below is bit for bit the one tri_intersect computes for that triangle. */
+VB_INLINE void quad_shear_vertex(const RayShear *rs, __global const VbLeafQuad *q, int k, float4 *x,
+                                 float4 *y, float4 *z)
+{
+    float4 px = vload4(0, q->xyz[3 * k]) - rs->org.x;
+    float4 py = vload4(0, q->xyz[3 * k + 1]) - rs->org.y;
+    float4 pz = vload4(0, q->xyz[3 * k + 2]) - rs->org.z;
+    float4 qx = vb_comp4(px, py, pz, rs->perm.x);
+    float4 qy = vb_comp4(px, py, pz, rs->perm.y);
+    float4 qz = vb_comp4(px, py, pz, rs->perm.z);
+    *x = qx - rs->sx * qz;
+    *y = qy - rs->sy * qz;
+    *z = rs->sz * qz;
+}
+
+/* The lanes of a quad that tri_intersect could accept within tmax (-1 per lane; padding
+ * lanes included, the caller masks them): tri_intersect's edge-sign and distance tests on
+ * all four triangles at once in float4 lanes. A lane is left out only where tri_intersect,
+ * computing the same values, rejects it too: with an edge function of exactly 0 (which
+ * tri_intersect decides again in double) or a NaN the lane stays in. The caller runs
+ * tri_intersect on the lanes left, so the hits are those of testing every triangle alone. */
+VB_INLINE int4 quad_candidates(const RayShear *rs, __global const VbLeafQuad *q, float tmax)
+{
+    float4 ax, ay, az, bx, by, bz, cx, cy, cz;
+    quad_shear_vertex(rs, q, 0, &ax, &ay, &az);
+    quad_shear_vertex(rs, q, 1, &bx, &by, &bz);
+    quad_shear_vertex(rs, q, 2, &cx, &cy, &cz);
+    float4 U = cx * by - cy * bx;
+    float4 V = ax * cy - ay * cx;
+    float4 W = bx * ay - by * ax;
+    int4 zero = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
+    int4 mixed = ((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f));
+    float4 det = U + V + W;
+    float4 T = U * az + V * bz + W * cz;
+    float4 lim = tmax * det;
+    int4 outside = select((T >= 0.0f) | (T < lim), (T <= 0.0f) | (T > lim), det > 0.0f);
+    return zero | ~(mixed | outside);
+}
+
+/* The triangles of a quad, -1 per lane for a real one (not padding). */
+VB_INLINE int4 quad_ids(__global const VbLeafQuad *q)
+{
+    return vload4(0, q->tri);
+}
+
+/* How many lanes of a mask (-1 or 0 each) are set. */
+VB_INLINE uint vb_count4(int4 m)
+{
+    return (uint)(-(m.s0 + m.s1 + m.s2 + m.s3));
+}
+
 /* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
- * updating *c. Returns the number of tests. */
+ * four at a time (quad_candidates) and then alone where the quad's test leaves them in,
+ * updating *c. Returns the number of triangles tested. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
                                  __global const VbTriangle *tris, __global const uint *leaf_start,
-                                 __global const uint *leaf_tris, uint leaf, Closest *c)
+                                 __global const VbLeafQuad *quads, uint leaf, Closest *c)
 {
-    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
-    for (uint k = begin; k < end; k++) closest_test(rs, org, tmax, tris, (int)leaf_tris[k], c);
-    return end - begin;
+    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1], n = 0;
+    for (uint k = begin; k < end; k++) {
+        __global const VbLeafQuad *q = quads + k;
+        int4 id = quad_ids(q);
+        if (id.s1 < 0) { /* one triangle: tested alone */
+            n++;
+            closest_test(rs, org, tmax, tris, id.s0, c);
+            continue;
+        }
+        int4 real = id >= 0;
+        n += vb_count4(real);
+        int4 cand = quad_candidates(rs, q, c->reach) & real;
+        if (cand.s0) closest_test(rs, org, tmax, tris, id.s0, c);
+        if (cand.s1) closest_test(rs, org, tmax, tris, id.s1, c);
+        if (cand.s2) closest_test(rs, org, tmax, tris, id.s2, c);
+        if (cand.s3) closest_test(rs, org, tmax, tris, id.s3, c);
+    }
+    return n;
 }
 
 /* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell (a sub-cell
@@ -207,8 +282,9 @@ VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
  * to the lower triangle index. */
 VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
                                    __global const VbGridCell *cells,
-                                   __global const uint *leaf_start, __global const uint *leaf_tris,
-                                   float3 org, float3 dir, float tmax, TraceCount *count)
+                                   __global const uint *leaf_start,
+                                   __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
+                                   float tmax, TraceCount *count)
 {
     Closest c;
     closest_begin(&c, tmax);
@@ -222,7 +298,7 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
         VbGridCell gc = cells[grid_cell_index(g, w.cell)];
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
         if (gc.res == VBCL_GRID_LIST) {
-            tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_tris, gc.first, &c);
+            tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_quads, gc.first, &c);
         } else {
             int3 n = grid_cell_res(gc);
             GridWalk s;
@@ -230,7 +306,7 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
             do {
                 steps++;
                 uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
-                tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_tris, leaf, &c);
+                tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_quads, leaf, &c);
                 float sub_exit = fmin(s.t_next.x, fmin(s.t_next.y, s.t_next.z));
                 if (c.hit.tri >= 0 && c.reach <= fmin(sub_exit, cell_exit)) break;
             } while (grid_walk_step(n, &s));
@@ -246,15 +322,30 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
 /* Whether any triangle of one leaf lies on the ray before tmax, those whose tag has a bit
  * of `skip` not counted; adds the tests to *tests. */
 VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
-                            __global const uint *leaf_start, __global const uint *leaf_tris,
+                            __global const uint *leaf_start, __global const VbLeafQuad *quads,
                             uint leaf, uint skip, uint *tests)
 {
     uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
-    int blocked = 0;
-    for (uint k = begin; k < end && !blocked; k++) {
-        blocked = any_test(rs, tmax, tris, (int)leaf_tris[k], skip, tests);
+    for (uint k = begin; k < end; k++) {
+        __global const VbLeafQuad *q = quads + k;
+        int4 id = quad_ids(q);
+        /* the real lanes of a quad share VBCL_TAG_TEXTURE (pack_leaf_quads), lane 0 is real */
+        if ((skip & tri_tag(tris, id.s0) & VBCL_TAG_TEXTURE) != 0u) continue;
+        if (id.s1 < 0) { /* one triangle: tested alone */
+            if (any_test(rs, tmax, tris, id.s0, skip, tests)) return 1;
+            continue;
+        }
+        int4 real = id >= 0;
+        *tests += vb_count4(real);
+        int4 cand = quad_candidates(rs, q, tmax) & real;
+        uint dummy = 0;
+        if ((cand.s0 && any_test(rs, tmax, tris, id.s0, skip, &dummy)) ||
+            (cand.s1 && any_test(rs, tmax, tris, id.s1, skip, &dummy)) ||
+            (cand.s2 && any_test(rs, tmax, tris, id.s2, skip, &dummy)) ||
+            (cand.s3 && any_test(rs, tmax, tris, id.s3, skip, &dummy)))
+            return 1;
     }
-    return blocked;
+    return 0;
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow
@@ -262,8 +353,8 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
  * (VBCL_TAG_TEXTURE, or 0) are not occluders. */
 VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
                              __global const VbGridCell *cells, __global const uint *leaf_start,
-                             __global const uint *leaf_tris, float3 org, float3 dir, float tmax,
-                             uint skip, TraceCount *count)
+                             __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
+                             float tmax, uint skip, TraceCount *count)
 {
     GridWalk w;
     if (!grid_walk_begin(g, org, dir, tmax, &w)) return 0;
@@ -276,7 +367,8 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
         VbGridCell gc = cells[grid_cell_index(g, w.cell)];
         float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
         if (gc.res == VBCL_GRID_LIST) {
-            blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, gc.first, skip, &tests);
+            blocked =
+                grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_quads, gc.first, skip, &tests);
         } else {
             int3 n = grid_cell_res(gc);
             GridWalk s;
@@ -284,7 +376,8 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
             do {
                 steps++;
                 uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
-                blocked = grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_tris, leaf, skip, &tests);
+                blocked =
+                    grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_quads, leaf, skip, &tests);
             } while (!blocked && grid_walk_step(n, &s));
         }
         t_in = cell_exit;
@@ -296,9 +389,9 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
 
 /* The leaves of one top cell that an axis-aligned box overlaps: for a walk of whole bundles
  * of rays, whose cone within the cell lies in the box. Leaf k of k = 0 .. count - 1 is
- * grid_box_leaf(&range, k); its triangles are leaf_tris[leaf_start[leaf] ..
- * leaf_start[leaf + 1] - 1]. A cell without a sub-grid gives its one list. A triangle can
- * be listed in several of the leaves. */
+ * grid_box_leaf(&range, k); its triangles are those of leaf_quads[leaf_start[leaf] ..
+ * leaf_start[leaf + 1] - 1] (lanes with tri >= 0). A cell without a sub-grid gives its one list. A
+ * triangle can be listed in several of the leaves. */
 typedef struct GridBoxRange {
     uint first; /* the cell's first leaf */
     int3 n;     /* its sub-grid resolution */
@@ -344,9 +437,9 @@ VB_INLINE uint grid_box_leaf(const GridBoxRange *r, uint k)
  * corners in q[4..6] and q[8..10], 12 floats a query) marks in mark[query * ntris + tri]
  * every triangle of the leaves grid_cell_box_range gives. */
 __kernel void probe_grid_box_range(__constant const VbFrame *f, __global const VbGridCell *cells,
-                                   __global const uint *leaf_start, __global const uint *leaf_tris,
-                                   __global const float *q, uint nq, uint ntris,
-                                   __global uchar *mark)
+                                   __global const uint *leaf_start,
+                                   __global const VbLeafQuad *leaf_quads, __global const float *q,
+                                   uint nq, uint ntris, __global uchar *mark)
 {
     uint i = get_global_id(0);
     if (i >= nq) return;
@@ -356,7 +449,8 @@ __kernel void probe_grid_box_range(__constant const VbFrame *f, __global const V
     for (uint k = 0; k < r.count; k++) {
         uint leaf = grid_box_leaf(&r, k);
         for (uint j = leaf_start[leaf]; j < leaf_start[leaf + 1]; j++)
-            mark[(size_t)i * ntris + leaf_tris[j]] = 1;
+            for (int l = 0; l < 4; l++)
+                if (leaf_quads[j].tri[l] >= 0) mark[(size_t)i * ntris + leaf_quads[j].tri[l]] = 1;
     }
 }
 #endif

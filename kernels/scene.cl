@@ -49,8 +49,8 @@ VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMater
 VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, float tmax,
                                     TraceCount *tc)
 {
-    return grid_trace_closest(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_tris,
-                              org, dir, tmax, tc);
+    return grid_trace_closest(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start,
+                              sc->leaf_quads, org, dir, tmax, tc);
 }
 
 /* Whether anything lies on (org, dir) before tmax, triangles whose tag has a bit of `skip`
@@ -58,7 +58,7 @@ VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, 
 VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float tmax, uint skip,
                               TraceCount *tc)
 {
-    return grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_tris,
+    return grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_quads,
                           org, dir, tmax, skip, tc);
 }
 

@@ -212,6 +212,16 @@ typedef struct VbGridCell {
     unsigned int first;
     unsigned int res;
 } VbGridCell;
+/* Four triangles of one leaf, laid out for a test of all four in float4 lanes (grid.cl,
+ * quad_candidates): xyz[3 k + a] holds coordinate a (x, y, z) of vertex k of the four
+ * triangles, tri their indices; a leaf's last quad is padded with tri -1 (and zero
+ * vertices). A leaf of n triangles has ceil(n / 4) quads, in ascending triangle order.
+ * Written by pack_leaf_quads (host/device/device_scene.c). */
+typedef struct VbLeafQuad {
+    float xyz[9][4];
+    int tri[4];
+} VbLeafQuad;
+
 #define VBCL_GRID_SUB_BITS 10
 #define VBCL_GRID_SUB_MASK 1023u
 #define VBCL_GRID_LIST     (1u | 1u << VBCL_GRID_SUB_BITS | 1u << (2 * VBCL_GRID_SUB_BITS))
@@ -313,6 +323,7 @@ typedef struct VbSplitSet {
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
+    X(sizeof(VbLeafQuad)) X(VBCL_OFFSETOF(VbLeafQuad, tri))                                        \
     X(VBCL_OFFSETOF(VbFrame, grid)) X(VBCL_OFFSETOF(VbFrame, background))                          \
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
@@ -345,6 +356,8 @@ VBCL_STATIC_ASSERT(sizeof(VbGrid) == 80, grid_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGrid, n) == 64, grid_n);
 VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
+VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
 VBCL_STATIC_ASSERT(sizeof(VbObject) == 112, object_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, nelems) == 100, object_nelems);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, first_tri) == 80, object_first_tri);
@@ -400,8 +413,8 @@ VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, c
     X(__global, VbTriangle, tris, tris)                                                            \
     X(__global, VbTriNormals, normals, normals)                                                    \
     X(__global, VbGridCell, grid_cells, grid_cells) /* one per top cell */                         \
-    X(__global, uint, leaf_start, leaf_start)       /* offsets of the leaves' lists */             \
-    X(__global, uint, leaf_tris, leaf_tris)         /* the lists: triangle indices */              \
+    X(__global, uint, leaf_start, leaf_start)       /* offsets of the leaves' quads */             \
+    X(__global, VbLeafQuad, leaf_quads, leaf_quads) /* their triangles, four at a time */          \
     X(__global, VbMaterial, materials, materials)                                                  \
     X(__global, VbObject, objects, objects)                                                        \
     X(__global, VbLight, lights, lights)                                                           \

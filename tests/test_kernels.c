@@ -274,7 +274,7 @@ static void test_grid_cell_box_range(void)
     const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem),  sizeof(cl_mem),  sizeof(cl_mem),
                          sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_uint), sizeof(cl_mem)};
     const void *v[] = {
-        &mf, &fx.r.buf.grid_cells, &fx.r.buf.leaf_start, &fx.r.buf.leaf_tris, &mq, &nq, &ntris,
+        &mf, &fx.r.buf.grid_cells, &fx.r.buf.leaf_start, &fx.r.buf.leaf_quads, &mq, &nq, &ntris,
         &mm};
     run_kernel(fx.r.program, "probe_grid_box_range", NQ, 8, sz, v);
     read_buffer(mm, mark, (size_t)NQ * ntris);

@@ -673,3 +673,15 @@ void grid_free(Grid *g)
     grid_leaves_free(g);
     memset(g, 0, sizeof *g);
 }
+
+size_t grid_leaf_quads(const Grid *g, const uint32_t *tri_tag, uint32_t kind_bit)
+{
+    size_t n = 0;
+    for (uint32_t l = 0; l < g->nleaves; l++) {
+        size_t with = 0, all = (size_t)g->leaf_start[l + 1] - g->leaf_start[l];
+        for (uint32_t i = g->leaf_start[l]; i < g->leaf_start[l + 1]; i++)
+            with += (tri_tag[g->leaf_tris[i]] & kind_bit) != 0u;
+        n += (with + 3) / 4 + (all - with + 3) / 4;
+    }
+    return n;
+}

@@ -124,6 +124,11 @@ int grid_build_levels(Grid *g, const Mesh *m, const int res[3], float density, c
 /* Frees the arrays and zeroes the grid; safe on a zeroed or failed grid. */
 void grid_free(Grid *g);
 
+/* Quads the kernels' leaves take (VbLeafQuad, kernels/types.h): per leaf, its triangles whose
+ * tag (tri_tag, the scene's per-triangle tags) has `kind_bit` and those without it, each
+ * group four to a quad. */
+size_t grid_leaf_quads(const Grid *g, const uint32_t *tri_tag, uint32_t kind_bit);
+
 /* Exact triangle / axis-aligned box overlap (separating axis test, Akenine-Möller 2001), in
  * double precision; touching counts as overlap. Works for degenerate triangles too. Returns
  * 1 when the triangle overlaps the box centre +- half, else 0. */

@@ -67,6 +67,49 @@ static VbTriangle *pack_triangles(const Scene *s)
     return t;
 }
 
+/* The leaves' triangles four at a time (VbLeafQuad, kernels/types.h): leaf l's quads are
+ * quads[start[l] .. start[l + 1] - 1], first those of its scene triangles and then those of
+ * its texture triangles, each in the order of g->leaf_tris, a kind's last quad padded with
+ * tri -1, so that all real lanes of a quad share VBCL_TAG_TEXTURE. Returns the quads (NULL:
+ * out of memory; *start too) and their number in *nquads. */
+static VbLeafQuad *pack_leaf_quads(const Grid *g, const uint32_t *tri_tag, const VbTriangle *tris,
+                                   uint32_t **start, uint32_t *nquads)
+{
+    size_t n = grid_leaf_quads(g, tri_tag, VBCL_TAG_TEXTURE);
+    *nquads = (uint32_t)n;
+    *start = malloc(sizeof **start * ((size_t)g->nleaves + 1));
+    VbLeafQuad *q = calloc(n ? n : 1, sizeof *q);
+    if (!q || !*start) {
+        free(q);
+        free(*start);
+        *start = NULL;
+        return NULL;
+    }
+    size_t k = 0;
+    for (uint32_t l = 0; l < g->nleaves; l++) {
+        (*start)[l] = (uint32_t)k;
+        for (int texture = 0; texture < 2; texture++) {
+            uint32_t lane = 0;
+            for (uint32_t i = g->leaf_start[l]; i < g->leaf_start[l + 1]; i++) {
+                uint32_t t = g->leaf_tris[i];
+                if (((tri_tag[t] & VBCL_TAG_TEXTURE) != 0u) != texture) continue;
+                if (lane == 4) {
+                    lane = 0;
+                    k++;
+                }
+                if (lane == 0)
+                    for (int j = 0; j < 4; j++) q[k].tri[j] = -1;
+                const float *v[3] = {tris[t].v0, tris[t].v1, tris[t].v2};
+                for (int a = 0; a < 9; a++) q[k].xyz[a][lane] = v[a / 3][a % 3];
+                q[k].tri[lane++] = (int)t;
+            }
+            if (lane > 0) k++;
+        }
+    }
+    (*start)[g->nleaves] = (uint32_t)k;
+    return q;
+}
+
 static VbTriNormals *pack_normals(const Scene *s)
 {
     const Mesh *m = &s->mesh;
@@ -215,7 +258,8 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
                            unsigned features, char *err, size_t errlen)
 {
     size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
-    if (nbytes_tris > dev->max_alloc || sizeof(uint32_t) * (size_t)g->nleaf_refs > dev->max_alloc ||
+    if (nbytes_tris > dev->max_alloc ||
+        sizeof(VbLeafQuad) * grid_leaf_quads(g, s->tri_tag, VBCL_TAG_TEXTURE) > dev->max_alloc ||
         sizeof(uint32_t) * ((size_t)g->nleaves + 1) > dev->max_alloc) {
         snprintf(err, errlen,
                  "%s: the scene (%u triangles, %u grid references in %u leaves) does not fit "
@@ -226,9 +270,13 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
     }
     VbTriangle *tris = pack_triangles(s);
     VbTriNormals *normals = pack_normals(s);
-    if (!tris || !normals) {
+    uint32_t *quad_start = NULL, nquads = 0;
+    VbLeafQuad *quads = tris ? pack_leaf_quads(g, s->tri_tag, tris, &quad_start, &nquads) : NULL;
+    if (!tris || !normals || !quads) {
         free(tris);
         free(normals);
+        free(quads);
+        free(quad_start);
         snprintf(err, errlen, "out of memory packing %u triangles", s->mesh.ntris);
         return 1;
     }
@@ -241,10 +289,11 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
     free(normals);
     b->grid_cells = clu_buffer(dev, g->cells, sizeof(VbGridCell) * g->ncells, CL_MEM_READ_ONLY);
     b->leaf_start =
-        clu_buffer(dev, g->leaf_start, sizeof(uint32_t) * (g->nleaves + 1u), CL_MEM_READ_ONLY);
-    b->leaf_tris =
-        clu_buffer(dev, g->leaf_tris, sizeof(uint32_t) * g->nleaf_refs, CL_MEM_READ_ONLY);
-    if (b->tris && b->normals && b->grid_cells && b->leaf_start && b->leaf_tris) return 0;
+        clu_buffer(dev, quad_start, sizeof(uint32_t) * (g->nleaves + 1u), CL_MEM_READ_ONLY);
+    b->leaf_quads = clu_buffer(dev, quads, sizeof(VbLeafQuad) * nquads, CL_MEM_READ_ONLY);
+    free(quad_start);
+    free(quads);
+    if (b->tris && b->normals && b->grid_cells && b->leaf_start && b->leaf_quads) return 0;
     snprintf(err, errlen, "%s: %s", dev->name, clu_error());
     return 1;
 }
