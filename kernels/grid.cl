@@ -236,7 +236,7 @@ VB_INLINE int4 quad_candidates(const RayShear *rs, __global const VbLeafQuad *q,
     return zero | ~(mixed | outside);
 }
 
-/* The triangles of a quad, -1 per lane for a real one (not padding). */
+/* The triangles of a quad, one index per lane (-1: padding). */
 VB_INLINE int4 quad_ids(__global const VbLeafQuad *q)
 {
     return vload4(0, q->tri);
@@ -320,7 +320,8 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
 }
 
 /* Whether any triangle of one leaf lies on the ray before tmax, those whose tag has a bit
- * of `skip` not counted; adds the tests to *tests. */
+ * of `skip` not counted; adds the tests to *tests (a quad's real lanes; a skipped texture
+ * quad none). */
 VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
                             __global const uint *leaf_start, __global const VbLeafQuad *quads,
                             uint leaf, uint skip, uint *tests)
@@ -338,7 +339,7 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
         int4 real = id >= 0;
         *tests += vb_count4(real);
         int4 cand = quad_candidates(rs, q, tmax) & real;
-        uint dummy = 0;
+        uint dummy = 0; /* the quad's triangles are counted above */
         if ((cand.s0 && any_test(rs, tmax, tris, id.s0, skip, &dummy)) ||
             (cand.s1 && any_test(rs, tmax, tris, id.s1, skip, &dummy)) ||
             (cand.s2 && any_test(rs, tmax, tris, id.s2, skip, &dummy)) ||
