@@ -214,9 +214,10 @@ typedef struct VbGridCell {
 } VbGridCell;
 /* Four triangles of one leaf, laid out for a test of all four in float4 lanes (grid.cl,
  * quad_candidates): xyz[3 k + a] holds coordinate a (x, y, z) of vertex k of the four
- * triangles, tri their indices; a leaf's last quad is padded with tri -1 (and zero
- * vertices). A leaf of n triangles has ceil(n / 4) quads, in ascending triangle order.
- * Written by pack_leaf_quads (host/device/device_scene.c). */
+ * triangles, tri their indices. A leaf's scene triangles and its texture triangles fill
+ * quads of their own (ceil(n / 4) each, in ascending triangle order), the last of each
+ * padded with tri -1 (and zero vertices). Written by pack_leaf_quads
+ * (host/device/device_scene.c), counted by grid_leaf_quads (host/accel/grid.c). */
 typedef struct VbLeafQuad {
     float xyz[9][4];
     int tri[4];
