@@ -421,6 +421,27 @@ VB_INLINE float3 light_cap_at(float2 u, float one_minus_cos, float3 tx, float3 t
     return normalize(tx * (sin_t * cospi(turn)) + ty * (sin_t * sinpi(turn)) + wc * cos_t);
 }
 
+/* Whether the light's reflected radiance at sp, where no feeler is stopped or dimmed, has a
+ * closed form: a purely diffuse BRDF, the whole cap above the horizons of both normals (with
+ * a margin for the feelers' rounding) and a medium that absorbs nothing. Then it is
+ * L kd pi sin^2(alpha) (ns . wc) exactly (the integral of cos over the cap), the value the
+ * feelers' mean estimates. */
+VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
+                                    const LightShading *ls, float3 wc, float sin_max)
+{
+#ifdef VBCL_HAS_SPECULAR
+    if (ls->specular) return 0;
+#endif
+#ifdef VBCL_HAS_ABSORPTION
+    if (vb_max3(vb_gload3(scn->materials[medium_material(scn, sp->medium)].extinction)) != 0.0f)
+        return 0;
+#else
+    (void)scn;
+#endif
+    float m = sin_max + 1e-4f;
+    return ls->diffuse && dot(sp->ns, wc) > m && dot(sp->ng, wc) > m;
+}
+
 #ifdef VBCL_HAS_AREA_LIGHTS
 /* The direction of feeler (i, j) on the cap (light_cap_at at light_cap_uv). */
 VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float one_minus_cos,
@@ -455,6 +476,12 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     ObjectSet os;
     light_cone_objects(scn, sp, ls, r, &os);
     int tex_free = sp->medium.tex_counts == 0u;
+    int closed = light_cap_closed_form(scn, sp, ls, wc, sin_max);
+    if (closed && os.n == 0 && os.nbig == 0) { /* every feeler would be clear */
+        sc->clear += strata * strata;
+        return radiance * ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
+    }
+    uint open = 0u; /* feelers that found nothing in the way */
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
@@ -476,12 +503,15 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float3 vis =
                 light_feeler_decided(scn, sp, &os, ls->origin, w, t_light, tex_free, tc, sc);
             if (vb_max3(vis) <= 0.0f) continue;
+            open += fmin(vis.x, fmin(vis.y, vis.z)) >= 1.0f;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
             if (ls->specular && nh > ls->nh_min) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
 #endif
         }
     }
+    if (closed && open == strata * strata) /* as if the cone test had found nothing */
+        return radiance * ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
     float scale = omega / (float)(strata * strata);
     float3 sum_d = ls->kd * (sum_cos * scale);
 #ifdef VBCL_HAS_SPECULAR

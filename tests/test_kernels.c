@@ -381,65 +381,78 @@ static void test_contact_opaque_surface_first(void)
 
 /* Local shading at points under a spherical light, diffuse reflectance 1, no ambient:
  * outgoing radiance = E / pi with E = pi L sin^2(alpha) cos(beta) whenever the whole cap
- * is above the horizon (alpha: the cap's half angle, beta: the tilt of the normal). */
+ * is above the horizon (alpha: the cap's half angle, beta: the tilt of the normal). Twice:
+ * a purely diffuse surface, which light_cap_closed_form shades by that closed form (to 1e-5),
+ * and the same with a specular term of 1e-7, which the feelers estimate (1024 of them, to
+ * 1e-3). */
 static void test_light_irradiance_closed_form(void)
 {
-    Fixture fx;
-    /* the only geometry is a small box far behind the light, so nothing occludes */
-    if (fixture_open(&fx,
-                     "{" CAM "\"render\": {\"shadow_samples\": 1024, \"ambient\": [0, 0, 0]},"
-                     " \"lights\": [{\"centre\": [0, 0, 0], \"radius\": 1, \"flux\": 1000},"
-                     "              {\"centre\": [0, 0, 0], \"radius\": 0, \"intensity\": 0.001}],"
-                     " \"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}},"
-                     " \"objects\": [{\"shape\": \"box\", \"material\": \"m\", \"transform\": "
-                     "{\"translate\": [0, 0, -100]}}]}"))
-        return;
-    const double flux = 1000.0, R = 1.0, I_point = 0.001;
-    const double L = flux / (4.0 * M_PI * M_PI * R * R);
-    enum { N = 6 };
-    /* distance d, tilt beta (degrees), in the plane of x and y */
-    const double cases[N][2] = {{5, 0}, {1.05, 0}, {20, 40}, {3, 60}, {1.5, 30}, {2, 25}};
-    float pts[N * 4], nrm[N * 4], out[N * 4];
-    for (int i = 0; i < N; i++) {
-        double d = cases[i][0], b = cases[i][1] * M_PI / 180.0;
-        /* point on +x at distance d; the normal points back at the light, tilted by beta */
-        pts[4 * i] = (float)d, pts[4 * i + 1] = 0, pts[4 * i + 2] = 0, pts[4 * i + 3] = 0;
-        nrm[4 * i] = (float)-cos(b), nrm[4 * i + 1] = (float)sin(b), nrm[4 * i + 2] = 0,
-                nrm[4 * i + 3] = 0;
+    static const char *const materials[2] = {
+        "{\"diffuse\": [1, 1, 1]}",
+        "{\"diffuse\": [1, 1, 1], \"specular\": [1e-7, 1e-7, 1e-7], \"exponent\": 1}"};
+    for (int mi = 0; mi < 2; mi++) {
+        Fixture fx;
+        char json[1024];
+        /* the only geometry is a small box far behind the light, so nothing occludes */
+        snprintf(json, sizeof json,
+                 "{" CAM "\"render\": {\"shadow_samples\": 1024, \"ambient\": [0, 0, 0]},"
+                 " \"lights\": [{\"centre\": [0, 0, 0], \"radius\": 1, \"flux\": 1000},"
+                 "              {\"centre\": [0, 0, 0], \"radius\": 0, \"intensity\": 0.001}],"
+                 " \"materials\": {\"m\": %s},"
+                 " \"objects\": [{\"shape\": \"box\", \"material\": \"m\", \"transform\": "
+                 "{\"translate\": [0, 0, -100]}}]}",
+                 materials[mi]);
+        if (fixture_open(&fx, json)) return;
+        const double tol = mi ? 1e-3 : 1e-5;
+        fprintf(stderr, "    %s:\n", mi ? "feelers (specular 1e-7)" : "closed form (diffuse)");
+        const double flux = 1000.0, R = 1.0, I_point = 0.001;
+        const double L = flux / (4.0 * M_PI * M_PI * R * R);
+        enum { N = 6 };
+        /* distance d, tilt beta (degrees), in the plane of x and y */
+        const double cases[N][2] = {{5, 0}, {1.05, 0}, {20, 40}, {3, 60}, {1.5, 30}, {2, 25}};
+        float pts[N * 4], nrm[N * 4], out[N * 4];
+        for (int i = 0; i < N; i++) {
+            double d = cases[i][0], b = cases[i][1] * M_PI / 180.0;
+            /* point on +x at distance d; the normal points back at the light, tilted by beta */
+            pts[4 * i] = (float)d, pts[4 * i + 1] = 0, pts[4 * i + 2] = 0, pts[4 * i + 3] = 0;
+            nrm[4 * i] = (float)-cos(b), nrm[4 * i + 1] = (float)sin(b), nrm[4 * i + 2] = 0,
+                    nrm[4 * i + 3] = 0;
+        }
+        cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
+               mo = buffer(NULL, sizeof out);
+        int n = N;
+        const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+        const void *v[] = {&mp, &mn, &n, &mo};
+        fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
+        read_buffer(mo, out, sizeof out);
+        for (int i = 0; i < N; i++) {
+            double d = cases[i][0], b = cases[i][1] * M_PI / 180.0, s2 = R * R / (d * d);
+            double alpha = asin(R / d);
+            CHECK(b + alpha < M_PI / 2, "case %d: the cap must be above the horizon", i);
+            double e_sphere = M_PI * L * s2 * cos(b);
+            double e_point = I_point * cos(b) / (d * d);
+            double want = (e_sphere + e_point) / M_PI;
+            double got = out[4 * i];
+            fprintf(stderr,
+                    "    d %.2f tilt %2.0f: radiance %.6g, closed form %.6g (rel. error %.2e)\n", d,
+                    cases[i][1], got, want, fabs(got - want) / want);
+            CHECK(fabs(got - want) <= tol * want, "%s case %d: radiance %.6g, closed form %.6g",
+                  materials[mi], i, got, want);
+        }
+        /* facing away from both lights: no feelers, no light */
+        nrm[0] = 1, nrm[1] = 0, nrm[2] = 0;
+        n = 1;
+        clEnqueueWriteBuffer(tu_device()->queue, mn, CL_TRUE, 0, sizeof(float) * 4, nrm, 0, NULL,
+                             NULL);
+        fixture_run_probe(&fx, "probe_shade_points", 1, 4, sz, v);
+        read_buffer(mo, out, sizeof(float) * 4);
+        CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced",
+              out[0], out[3]);
+        clReleaseMemObject(mp);
+        clReleaseMemObject(mn);
+        clReleaseMemObject(mo);
+        fixture_close(&fx);
     }
-    cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
-           mo = buffer(NULL, sizeof out);
-    int n = N;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *v[] = {&mp, &mn, &n, &mo};
-    fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
-    read_buffer(mo, out, sizeof out);
-    for (int i = 0; i < N; i++) {
-        double d = cases[i][0], b = cases[i][1] * M_PI / 180.0, s2 = R * R / (d * d);
-        double alpha = asin(R / d);
-        CHECK(b + alpha < M_PI / 2, "case %d: the cap must be above the horizon", i);
-        double e_sphere = M_PI * L * s2 * cos(b);
-        double e_point = I_point * cos(b) / (d * d);
-        double want = (e_sphere + e_point) / M_PI;
-        double got = out[4 * i];
-        fprintf(stderr,
-                "    d %.2f tilt %2.0f: radiance %.6g, closed form %.6g (rel. error %.2e)\n", d,
-                cases[i][1], got, want, fabs(got - want) / want);
-        CHECK(fabs(got - want) <= 1e-3 * want, "case %d: radiance %.6g, closed form %.6g", i, got,
-              want);
-    }
-    /* facing away from both lights: no feelers, no light */
-    nrm[0] = 1, nrm[1] = 0, nrm[2] = 0;
-    n = 1;
-    clEnqueueWriteBuffer(tu_device()->queue, mn, CL_TRUE, 0, sizeof(float) * 4, nrm, 0, NULL, NULL);
-    fixture_run_probe(&fx, "probe_shade_points", 1, 4, sz, v);
-    read_buffer(mo, out, sizeof(float) * 4);
-    CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced", out[0],
-          out[3]);
-    clReleaseMemObject(mp);
-    clReleaseMemObject(mn);
-    clReleaseMemObject(mo);
-    fixture_close(&fx);
 }
 
 /* Random shading points for the cone probes, 16 floats each (probe_cone_brute's layout):
