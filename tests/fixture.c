@@ -126,3 +126,17 @@ int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const 
     clReleaseKernel(k);
     return rc == CL_SUCCESS ? 0 : -1;
 }
+
+int fixture_shade_points(Fixture *fx, const float *pts, const float *nrm, int n, float *out)
+{
+    size_t bytes = sizeof(float) * 4 * (size_t)n;
+    cl_mem mp = buffer(pts, bytes), mn = buffer(nrm, bytes), mo = buffer(NULL, bytes);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *v[] = {&mp, &mn, &n, &mo};
+    int rc = fixture_run_probe(fx, "probe_shade_points", (size_t)n, 4, sz, v);
+    if (rc == 0) read_buffer(mo, out, bytes);
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mn);
+    clReleaseMemObject(mo);
+    return rc;
+}

@@ -25,6 +25,9 @@ void read_buffer(cl_mem m, void *dst, size_t bytes);
  * nargs arguments of its own. */
 int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const size_t *sizes,
                       const void *const *vals);
+/* Shades n points (probe_shade_points: xyz per 4 floats, normals likewise, the normal's w the
+ * band + 1, 0 for white) into out (n x 4 floats: radiance, feelers traced). */
+int fixture_shade_points(Fixture *fx, const float *pts, const float *nrm, int n, float *out);
 /* Runs a frame kernel (FRAME_KERNEL_ARGS) of the fixture over n rays, with fresh media and
  * radiance buffers; hits and counters are the caller's. */
 void fixture_run_frame_kernel(Fixture *fx, const char *name, cl_mem rays, int n, cl_mem hits,

@@ -447,13 +447,10 @@ static void test_dispersion_shadow_feelers(void)
         pts[4 * i] = 2.0f, pts[4 * i + 1] = pts[4 * i + 2] = pts[4 * i + 3] = 0;
         nrm[4 * i] = -1.0f, nrm[4 * i + 1] = nrm[4 * i + 2] = 0, nrm[4 * i + 3] = (float)i;
     }
-    cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
-           mo = buffer(NULL, sizeof out);
-    int n = N;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *v[] = {&mp, &mn, &n, &mo};
-    fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
-    read_buffer(mo, out, sizeof out);
+    if (fixture_shade_points(&fx, pts, nrm, N, out)) {
+        fixture_close(&fx);
+        return;
+    }
     const double unlit = 1.0 / (4.0 * M_PI); /* E = I / d², radiance E / π, d = 2 */
     double white[3] = {0, 0, 0}, in[3] = {0, 0, 0}, outw[3] = {0, 0, 0};
     for (int k = 0; k < nb; k++) {
@@ -480,9 +477,6 @@ static void test_dispersion_shadow_feelers(void)
             "%.5f); base eta alone would give %.5f\n",
             out[0] / unlit, out[1] / unlit, out[2] / unlit, white[0], white[1], white[2],
             pow(1 - pow(0.6 / 2.6, 2), 2));
-    clReleaseMemObject(mp);
-    clReleaseMemObject(mn);
-    clReleaseMemObject(mo);
     fixture_close(&fx);
 }
 

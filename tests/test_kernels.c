@@ -418,13 +418,10 @@ static void test_light_irradiance_closed_form(void)
             nrm[4 * i] = (float)-cos(b), nrm[4 * i + 1] = (float)sin(b), nrm[4 * i + 2] = 0,
                     nrm[4 * i + 3] = 0;
         }
-        cl_mem mp = buffer(pts, sizeof pts), mn = buffer(nrm, sizeof nrm),
-               mo = buffer(NULL, sizeof out);
-        int n = N;
-        const size_t sz[] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-        const void *v[] = {&mp, &mn, &n, &mo};
-        fixture_run_probe(&fx, "probe_shade_points", N, 4, sz, v);
-        read_buffer(mo, out, sizeof out);
+        if (fixture_shade_points(&fx, pts, nrm, N, out)) {
+            fixture_close(&fx);
+            return;
+        }
         for (int i = 0; i < N; i++) {
             double d = cases[i][0], b = cases[i][1] * M_PI / 180.0, s2 = R * R / (d * d);
             double alpha = asin(R / d);
@@ -441,16 +438,9 @@ static void test_light_irradiance_closed_form(void)
         }
         /* facing away from both lights: no feelers, no light */
         nrm[0] = 1, nrm[1] = 0, nrm[2] = 0;
-        n = 1;
-        clEnqueueWriteBuffer(tu_device()->queue, mn, CL_TRUE, 0, sizeof(float) * 4, nrm, 0, NULL,
-                             NULL);
-        fixture_run_probe(&fx, "probe_shade_points", 1, 4, sz, v);
-        read_buffer(mo, out, sizeof(float) * 4);
-        CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced",
-              out[0], out[3]);
-        clReleaseMemObject(mp);
-        clReleaseMemObject(mn);
-        clReleaseMemObject(mo);
+        if (fixture_shade_points(&fx, pts, nrm, 1, out) == 0)
+            CHECK(out[0] == 0.0f && out[3] == 0.0f, "facing away: radiance %g, %g feelers traced",
+                  out[0], out[3]);
         fixture_close(&fx);
     }
 }
