@@ -422,16 +422,15 @@ VB_INLINE float3 light_cap_at(float2 u, float one_minus_cos, float3 tx, float3 t
 }
 
 /* Whether the light's reflected radiance at sp, where no feeler is stopped or dimmed, has a
- * closed form: a purely diffuse BRDF, the whole cap above the horizons of both normals (with
- * a margin for the feelers' rounding) and a medium that absorbs nothing. Then it is
- * L kd pi sin^2(alpha) (ns . wc) exactly (the integral of cos over the cap), the value the
- * feelers' mean estimates. */
+ * closed form: a diffuse BRDF whose specular lobe, if any, misses the whole cap
+ * (light_lobe_misses_cap: no feeler would add a specular term), the whole cap above the
+ * horizons of both normals (with a margin for the feelers' rounding) and a medium that absorbs
+ * nothing. Then it is L kd pi sin^2(alpha) (ns . wc) exactly (the integral of cos over the
+ * cap), the value the feelers' mean estimates. */
 VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
                                     const LightShading *ls, float3 wc, float sin_max)
 {
-#ifdef VBCL_HAS_SPECULAR
-    if (ls->specular) return 0;
-#endif
+    if (!ls->diffuse || !light_lobe_misses_cap(ls, sp, wc, sin_max)) return 0;
 #ifdef VBCL_HAS_ABSORPTION
     if (vb_max3(vb_gload3(scn->materials[medium_material(scn, sp->medium)].extinction)) != 0.0f)
         return 0;
@@ -439,7 +438,7 @@ VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
     (void)scn;
 #endif
     float m = sin_max + 1e-4f;
-    return ls->diffuse && dot(sp->ns, wc) > m && dot(sp->ng, wc) > m;
+    return dot(sp->ns, wc) > m && dot(sp->ng, wc) > m;
 }
 
 #ifdef VBCL_HAS_AREA_LIGHTS
