@@ -467,19 +467,19 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
         sc->unneeded += strata * strata;
         return (float3)(0.0f);
     }
-    float omega = light_cap_solid_angle(r, ls->d);
-    float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
-    float3 tx, ty;
-    vb_frame(wc, &tx, &ty);
-    CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
     ObjectSet os;
     light_cone_objects(scn, sp, ls, r, &os);
-    int tex_free = sp->medium.tex_counts == 0u;
     int closed = light_cap_closed_form(scn, sp, ls, wc, sin_max);
     if (closed && os.n == 0 && os.nbig == 0) { /* every feeler would be clear */
         sc->clear += strata * strata;
         return radiance * ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
     }
+    float omega = light_cap_solid_angle(r, ls->d);
+    float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
+    float3 tx, ty;
+    vb_frame(wc, &tx, &ty);
+    CapFeelers cf = light_cap_feelers(light_feeler_mode(scn->f->flags), strata, key);
+    int tex_free = sp->medium.tex_counts == 0u;
     uint open = 0u; /* feelers that found nothing in the way */
     float3 sum_cos = (float3)(0.0f);
 #ifdef VBCL_HAS_SPECULAR
