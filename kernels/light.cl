@@ -441,6 +441,13 @@ VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
     return dot(sp->ns, wc) > m && dot(sp->ng, wc) > m;
 }
 
+/* That closed form (light_cap_closed_form), per unit of the light's radiance. */
+VB_INLINE float3 light_cap_closed(const LightShading *ls, const ShadePoint *sp, float3 wc,
+                                  float sin_max)
+{
+    return ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
+}
+
 #ifdef VBCL_HAS_AREA_LIGHTS
 /* The direction of feeler (i, j) on the cap (light_cap_at at light_cap_uv). */
 VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float one_minus_cos,
@@ -472,7 +479,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     int closed = light_cap_closed_form(scn, sp, ls, wc, sin_max);
     if (closed && os.n == 0 && os.nbig == 0) { /* every feeler would be clear */
         sc->clear += strata * strata;
-        return radiance * ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
+        return radiance * light_cap_closed(ls, sp, wc, sin_max);
     }
     float omega = light_cap_solid_angle(r, ls->d);
     float one_minus_cos = omega * (1.0f / (2.0f * VB_PI));
@@ -510,7 +517,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
         }
     }
     if (closed && open == strata * strata) /* as if the cone test had found nothing */
-        return radiance * ls->kd * (VB_PI * sin_max * sin_max * dot(sp->ns, wc));
+        return radiance * light_cap_closed(ls, sp, wc, sin_max);
     float scale = omega / (float)(strata * strata);
     float3 sum_d = ls->kd * (sum_cos * scale);
 #ifdef VBCL_HAS_SPECULAR
