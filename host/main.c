@@ -53,6 +53,7 @@ static const char usage_text[] =
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --subgrid-density D  sub-cells per triangle of a crowded top cell (default 2)\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
+    "      --seed N             seed of the feelers' jitter (0..2147483647; default 1)\n"
     "      --no-cone-test       trace every feeler, also where the cone from the point to\n"
     "                           the light meets no object's bounds (same image, slower)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
@@ -95,7 +96,7 @@ static const char usage_text[] =
 typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_map, *aa_samples_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
-    int width, height, shadow_samples, depth, aa_max_level, ssaa, bands;
+    int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
     int list_devices, stats, quiet, no_cone_test;
@@ -159,6 +160,7 @@ static const OptionSpec option_specs[] = {
     {"--grid-density", NULL, OPT_DOUBLE, offsetof(Options, grid_density), 0.01, 64},
     {"--subgrid-density", NULL, OPT_DOUBLE, offsetof(Options, subgrid_density), 0.01, 64},
     {"--shadow-samples", NULL, OPT_INT, offsetof(Options, shadow_samples), 1, 1024},
+    {"--seed", NULL, OPT_INT, offsetof(Options, seed), 0, 2147483647.0},
     {"--depth", NULL, OPT_INT, offsetof(Options, depth), 1, 64},
     {"--min-weight", NULL, OPT_DOUBLE, offsetof(Options, min_weight), 0, 1},
     {"--aa", NULL, OPT_DOUBLE, offsetof(Options, aa), 0, 1},
@@ -261,7 +263,7 @@ static int parse_args(int argc, char **argv, Options *o)
     o->width = o->height = o->shadow_samples = o->depth = -1;
     o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
     o->aa_level_gain = -1;
-    o->aa_max_level = o->ssaa = o->bands = -1;
+    o->aa_max_level = o->ssaa = o->bands = o->seed = -1;
     o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -369,6 +371,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->width > 0) s->width = o->width;
     if (o->height > 0) s->height = o->height;
     if (o->shadow_samples > 0) s->shadow_samples = o->shadow_samples;
+    if (o->seed >= 0) s->seed = (unsigned)o->seed;
     if (o->grid_density > 0) s->grid_density = (float)o->grid_density;
     if (o->subgrid_density > 0) s->subgrid_density = (float)o->subgrid_density;
     if (o->have_exposure) s->exposure = (float)o->exposure;
