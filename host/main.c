@@ -56,6 +56,9 @@ static const char usage_text[] =
     "      --seed N             seed of the feelers' jitter (0..2147483647; default 1)\n"
     "      --no-cone-test       trace every feeler, also where the cone from the point to\n"
     "                           the light meets no object's bounds (same image, slower)\n"
+    "      --all-feelers        every point of a ray tree gets all its feelers (default: a\n"
+    "                           point whose share of its sample is w <= 1/4 gets about\n"
+    "                           w x N of the N, at least one)\n"
     "      --depth N            maximum depth of the ray tree (1..64)\n"
     "      --min-weight W       prune ray-tree branches weighing less than W (0..1)\n"
     "      --fresnel exact|thesis  energy split at interfaces: Fresnel, or thesis eq. 9\n"
@@ -99,7 +102,7 @@ typedef struct Options {
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
-    int list_devices, stats, quiet, no_cone_test;
+    int list_devices, stats, quiet, no_cone_test, all_feelers;
 } Options;
 
 static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -174,6 +177,7 @@ static const OptionSpec option_specs[] = {
     {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
     {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
     {"--no-cone-test", NULL, OPT_FLAG, offsetof(Options, no_cone_test), 0, 0},
+    {"--all-feelers", NULL, OPT_FLAG, offsetof(Options, all_feelers), 0, 0},
     {"--stats", NULL, OPT_FLAG, offsetof(Options, stats), 0, 0},
     {"--quiet", "-q", OPT_FLAG, offsetof(Options, quiet), 0, 0},
 };
@@ -381,6 +385,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->aa_floor >= 0) s->aa_floor = (float)o->aa_floor;
     if (o->aa_level_gain > 0) s->aa_level_gain = (float)o->aa_level_gain;
     if (o->no_cone_test) s->shadow_cone_test = 0;
+    if (o->all_feelers) s->shadow_by_weight = 0;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
     if (o->bands >= 0) {
         s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;

@@ -112,13 +112,17 @@ void stats_print(FILE *f, const StatsFrame *fr)
     double kernel_ms = stats_kernel_ms(st);
     unsigned strata = fr->r->frame_host.shadow_strata;
     print_setup(f, fr);
-    fprintf(f,
-            "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point; %llu "
-            "skipped: light behind the surface; %llu clear: not traced, their cone meets no "
-            "object; %llu blocked: not traced, they pass through an opaque texture part's core; "
-            "%llu unneeded: no BRDF response), total %llu\n",
-            st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata, st->shadow_skipped,
-            st->shadow_clear, st->shadow_blocked, st->shadow_unneeded, rays);
+    fprintf(
+        f,
+        "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point%s; %llu "
+        "skipped: light behind the surface; %llu clear: not traced, their cone meets no "
+        "object; %llu blocked: not traced, they pass through an opaque texture part's core; "
+        "%llu unneeded: no BRDF response), total %llu\n",
+        st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata,
+        (st->features & VBCL_FEATURE_TRANSPARENCY) && s->shadow_by_weight
+            ? ", fewer at ray-tree points weighing 1/4 or less"
+            : "",
+        st->shadow_skipped, st->shadow_clear, st->shadow_blocked, st->shadow_unneeded, rays);
     if (st->features & VBCL_FEATURE_TRANSPARENCY) print_tree(f, s, st);
     if (st->features & (VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_TEXTURES))
         fprintf(f, "media       %llu crossings passed through (no change of material)\n",

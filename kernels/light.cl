@@ -458,19 +458,23 @@ VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float
 
 /* Reflected radiance from a spherical light of radius r > 0 that the point sees from
  * outside: the visible cap sampled at strata^2 stratified directions, each direction's
- * feeler traced to the sphere, L * Omega * mean(V * f * cos). */
+ * feeler traced to the sphere, L * Omega * mean(V * f * cos). strata: the point's
+ * (light_node_strata); where the specular lobe can reach the cap the frame's own instead,
+ * since a highlight's feelers differ far more than a diffuse term's (their spread is what
+ * light_node_strata takes to be alike at every point). */
 VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
                                     const LightShading *ls, float3 radiance, float r, uint key,
-                                    TraceCount *tc, ShadowCount *sc)
+                                    uint strata, TraceCount *tc, ShadowCount *sc)
 {
-    uint strata = scn->f->shadow_strata;
     float3 wc = ls->to_c / ls->d;
     float sin_max = r / ls->d;
     if (dot(sp->ng, wc) < -sin_max) { /* the whole cap is below the horizon */
         sc->skipped += strata * strata;
         return (float3)(0.0f);
     }
-    if (!ls->diffuse && light_lobe_misses_cap(ls, sp, wc, sin_max)) {
+    int lobe_off = light_lobe_misses_cap(ls, sp, wc, sin_max);
+    if (!lobe_off) strata = scn->f->shadow_strata; /* a highlight keeps all its feelers */
+    if (!ls->diffuse && lobe_off) {
         sc->unneeded += strata * strata;
         return (float3)(0.0f);
     }
@@ -535,7 +539,8 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
  * of radius 0 is a point light. */
 VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *light,
                                    __global const VbMaterial *m, float3 diffuse,
-                                   const ShadePoint *sp, uint key, TraceCount *tc, ShadowCount *sc)
+                                   const ShadePoint *sp, uint key, uint strata, TraceCount *tc,
+                                   ShadowCount *sc)
 {
     float3 radiance = vb_gload3(light->radiance);
     float r = light->radius;
@@ -545,10 +550,11 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
         if (ls.d <= r * 1.0001f) { /* inside the light: lit from every direction, no shadow */
             return radiance * VB_PI * ls.kd;
         }
-        return light_reflect_area(scn, sp, &ls, radiance, r, key, tc, sc);
+        return light_reflect_area(scn, sp, &ls, radiance, r, key, strata, tc, sc);
     }
 #else
     (void)key;
+    (void)strata;
 #endif
     /* a point light: radiance holds the intensity (W/sr) */
     float3 w = ls.to_c / ls.d;
@@ -574,10 +580,27 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     return radiance * brdf * vis * (cos_n / ls.d2);
 }
 
+/* The side of the feeler grid of a point deeper in a ray tree whose local term counts for
+ * `weight` (the branch's weight times k_local, largest channel) in its sample: with
+ * VBCL_FRAME_WEIGHTED_FEELERS, the frame's strata halved while the smaller grid still has
+ * at least strata^2 * weight feelers, so the feelers of a node are about in proportion to
+ * its share of the sample (at weight 1/4 a quarter of them, at 1/16 a sixteenth; never
+ * fewer than one): the variance a node adds is weight^2 / feelers, and for a fixed number
+ * of feelers in all, the sum over nodes is least with feelers in proportion to weight.
+ * Otherwise, or for weight above 1/4, all of them. */
+VB_INLINE uint light_node_strata(__constant const VbFrame *f, float weight)
+{
+    uint s = f->shadow_strata;
+    if (!(f->flags & VBCL_FRAME_WEIGHTED_FEELERS)) return s;
+    float need = weight * (float)(s * s);
+    while (s > 1u && (float)((s >> 1) * (s >> 1)) >= need) s >>= 1;
+    return s;
+}
+
 /* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):
  * k_local * (ambient + sum over lights of diffuse + specular). */
-VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, TraceCount *tc,
-                                   ShadowCount *sc)
+VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, uint strata,
+                                   TraceCount *tc, ShadowCount *sc)
 {
     __global const VbMaterial *m = scn->materials + sp->material;
     float3 pattern = scene_pattern_colour(scn, m, sp->p);
@@ -585,7 +608,7 @@ VB_INLINE float3 light_shade_local(const DevScene *scn, const ShadePoint *sp, Tr
     float3 diffuse = vb_gload3(m->diffuse) * pattern;
     for (uint l = 0; l < scn->f->nlights; l++)
         col += light_reflect_one(scn, scn->lights + l, m, diffuse, sp,
-                                 vb_hash(sp->key * 0x27d4eb2fu + l), tc, sc);
+                                 vb_hash(sp->key * 0x27d4eb2fu + l), strata, tc, sc);
     return m->k_local * col;
 }
 

@@ -74,7 +74,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
     ShadowCount sc2 = {0, 0, 0, 0, 0};
-    float3 col = light_shade_local(&sc, &sp, &tc, &sc2);
+    float3 col = light_shade_local(&sc, &sp, f->shadow_strata, &tc, &sc2);
     vstore4((float4)(col, (float)sc2.traced), i, radiance);
 }
 
@@ -570,7 +570,7 @@ __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
     TraceCount tc = {0, 0};
     ShadowCount shc = {0, 0, 0, 0, 0};
     if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
-        col = light_shade_local(&sc, &sp, &tc, &shc);
+        col = light_shade_local(&sc, &sp, f->shadow_strata, &tc, &shc);
     /* decided: traced, or clear or blocked by the cone test */
     traced[j] = shc.traced + shc.clear + shc.blocked;
     vstore4((float4)(col, 0.0f), j, radiance);

@@ -183,7 +183,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
         ShadePoint sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, material);
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0, 0, 0, 0};
-        col = weight * light_shade_local(&sc, &sp, &tc, &shc);
+        col = weight * light_shade_local(&sc, &sp, f->shadow_strata, &tc, &shc);
         shade_flush_counts(counters, &tc, &shc);
     }
     vstore4((float4)(col, 1.0f), i, radiance);
@@ -216,7 +216,9 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, TreeCount *
         ShadePoint q = shade_point_make(sc, tr.dir, ph.hit, tr.key, state, ph.cx.surface);
         q.band = tr.band;
         __global const VbMaterial *ms = sc->materials + ph.cx.surface;
-        if (ms->k_local > 0.0f) acc += w * light_shade_local(sc, &q, tc, shc);
+        if (ms->k_local > 0.0f)
+            acc += w * light_shade_local(sc, &q, light_node_strata(f, vb_max3(w) * ms->k_local), tc,
+                                         shc);
         if (ms->k_global > 0.0f)
             tree_spawn(sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, cnt, tr.band,
                        rec);

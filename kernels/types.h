@@ -279,8 +279,10 @@ typedef struct VbFrame {
 #define VBCL_FRAME_FIXED_FEELERS 1u /* shadow feelers at stratum centres, the same everywhere */
 #define VBCL_FRAME_NET_FEELERS   2u /* jittered feelers of a power-of-two side: a scrambled net */
 #define VBCL_FRAME_CONE_TEST                                                                       \
-    4u                                /* a point's feelers toward a light whose cone meets no      \
-                                       * object's bounds are not traced (light_cone_objects) */
+    4u /* a point's feelers toward a light whose cone meets no                                     \
+        * object's bounds are not traced (light_cone_objects) */
+#define VBCL_FRAME_WEIGHTED_FEELERS                                                                \
+    8u /* a ray-tree node gets feelers in proportion to its weight (light_node_strata) */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */

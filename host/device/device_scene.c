@@ -701,6 +701,7 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
                                                              : VBCL_FRAME_NET_FEELERS;
     if (s->shadow_cone_test && s->nobjects <= VBCL_CONE_TEST_MAX_OBJECTS)
         f->flags |= VBCL_FRAME_CONE_TEST;
+    if (s->shadow_by_weight) f->flags |= VBCL_FRAME_WEIGHTED_FEELERS;
     f->nobjects = (unsigned)s->nobjects;
     scene_medium_at(s, s->eye, &f->camera_medium);
     f->air_material = (unsigned)s->nmaterials;

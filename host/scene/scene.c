@@ -255,6 +255,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "subgrid",
                                        "subgrid_density",
                                        "shadow_cone_test",
+                                       "shadow_by_weight",
                                        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
@@ -274,6 +275,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->band_layout = DISP_LAYOUT_UNIFORM;
     s->shadow_jitter = 1;
     s->shadow_cone_test = 1;
+    s->shadow_by_weight = 1;
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -289,7 +291,8 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         return -1;
     s->seed = (unsigned)seed;
     if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
-        get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test))
+        get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||
+        get_bool(c, j, "shadow_by_weight", &s->shadow_by_weight))
         return -1;
     const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
     if (fr) {

@@ -75,6 +75,8 @@ typedef struct Scene {
     unsigned seed;
     int shadow_jitter;    /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
     int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_objects) */
+    int shadow_by_weight; /* render.shadow_by_weight: feelers of ray-tree nodes by their weight
+                           * (light_node_strata); 0: all shadow_samples at every node */
     int fresnel;          /* SCENE_FRESNEL_* */
     float min_weight;     /* ray-tree pruning threshold */
     float aa_threshold;   /* adaptive anti-aliasing contrast threshold; 0: off */
