@@ -426,11 +426,12 @@ VB_INLINE float3 light_cap_at(float2 u, float one_minus_cos, float3 tx, float3 t
  * (light_lobe_misses_cap: no feeler would add a specular term), the whole cap above the
  * horizons of both normals (with a margin for the feelers' rounding) and a medium that absorbs
  * nothing. Then it is L kd pi sin^2(alpha) (ns . wc) exactly (the integral of cos over the
- * cap), the value the feelers' mean estimates. */
+ * cap), the value the feelers' mean estimates. lobe_off: light_lobe_misses_cap's answer for
+ * this cap, which the caller has already. */
 VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
-                                    const LightShading *ls, float3 wc, float sin_max)
+                                    const LightShading *ls, float3 wc, float sin_max, int lobe_off)
 {
-    if (!ls->diffuse || !light_lobe_misses_cap(ls, sp, wc, sin_max)) return 0;
+    if (!ls->diffuse || !lobe_off) return 0;
 #ifdef VBCL_HAS_ABSORPTION
     if (vb_max3(vb_gload3(scn->materials[medium_material(scn, sp->medium)].extinction)) != 0.0f)
         return 0;
@@ -480,7 +481,7 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
     }
     ObjectSet os;
     light_cone_objects(scn, sp, ls, r, &os);
-    int closed = light_cap_closed_form(scn, sp, ls, wc, sin_max);
+    int closed = light_cap_closed_form(scn, sp, ls, wc, sin_max, lobe_off);
     if (closed && os.n == 0 && os.nbig == 0) { /* every feeler would be clear */
         sc->clear += strata * strata;
         return radiance * light_cap_closed(ls, sp, wc, sin_max);
