@@ -32,20 +32,27 @@ VB_INLINE float3 ray_offset_origin(float3 p, float3 n, float scale)
                  fmax(fabs(tri_vertex(tris, tri, 1).xyz), fabs(tri_vertex(tris, tri, 2).xyz))))
 
 /* Per-ray constants of the watertight test (Woop, Benthin & Wald 2013): the axis
- * permutation that makes the largest direction component z (kx, ky, kz, as a shuffle
- * mask) and the shear that maps the ray onto +z. A vertex p maps to
- * (q.x - sx q.z, q.y - sy q.z, sz q.z) with q = shuffle(p - org): the same few operations
- * for every triangle that shares the vertex (contraction is off), which is what
- * watertightness needs, and a third of the multiplications of a full 3x3 shear. */
+ * permutation that makes the largest direction component z (kx, ky, kz) and the shear
+ * that maps the ray onto +z. A vertex p maps to (q.x - sx q.z, q.y - sy q.z, sz q.z) with
+ * q = (p - org) permuted: the same few operations for every triangle that shares the
+ * vertex (contraction is off), which is what watertightness needs, and a third of the
+ * multiplications of a full 3x3 shear. All in scalars: on a CPU, OpenCL's 3-lane vectors
+ * and a shuffle by a run-time mask cost lane moves that made the test about 5% slower. */
 typedef struct RayShear {
-    float4 org;
-    uint4 perm;
+    float ox, oy, oz; /* the origin */
+    uint kx, ky, kz;  /* the permutation */
     float sx, sy, sz;
 } RayShear;
 
+/* Coordinate k (0, 1, 2) of (x, y, z). */
+VB_INLINE float vb_pick(float x, float y, float z, uint k)
+{
+    return k == 0u ? x : (k == 1u ? y : z);
+}
+
 VB_INLINE float vb_comp(float3 v, uint k)
 {
-    return k == 0u ? v.x : (k == 1u ? v.y : v.z);
+    return vb_pick(v.x, v.y, v.z, k);
 }
 
 VB_INLINE RayShear ray_shear_make(float3 org, float3 dir)
@@ -64,30 +71,34 @@ VB_INLINE RayShear ray_shear_make(float3 org, float3 dir)
     r.sx = vb_comp(dir, kx) / dz;
     r.sy = vb_comp(dir, ky) / dz;
     r.sz = 1.0f / dz;
-    r.org = (float4)(org, 0.0f);
-    r.perm = (uint4)(kx, ky, kz, kz);
+    r.ox = org.x;
+    r.oy = org.y;
+    r.oz = org.z;
+    r.kx = kx;
+    r.ky = ky;
+    r.kz = kz;
     return r;
 }
 
-VB_INLINE float3 ray_shear_apply(const RayShear *r, float4 p)
+/* Vertex p through the ray's shear, in scalars (the same operations as on vectors). */
+VB_INLINE void ray_shear_apply(const RayShear *r, float4 p, float *x, float *y, float *z)
 {
-    float4 q = shuffle(p - r->org, r->perm);
-    return (float3)(q.x - r->sx * q.z, q.y - r->sy * q.z, r->sz * q.z);
+    float dx = p.x - r->ox, dy = p.y - r->oy, dz = p.z - r->oz;
+    float qx = vb_pick(dx, dy, dz, r->kx), qy = vb_pick(dx, dy, dz, r->ky),
+          qz = vb_pick(dx, dy, dz, r->kz);
+    *x = qx - r->sx * qz;
+    *y = qy - r->sy * qz;
+    *z = r->sz * qz;
 }
 
-/* Intersects the sheared ray with triangle (a, b, c). On a hit with 0 < t < tmax
- * returns 1 and writes t and the barycentric weights of b (u) and c (v). Rays through
- * a shared edge or vertex of a closed mesh hit at least one of its triangles. */
-VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
-                            float *t_out, float *u_out, float *v_out)
+/* The watertight test of a triangle whose vertices went through the ray's shear
+ * (ax .. cz) and whose edge functions are U = cx by - cy bx, V = ax cy - ay cx and
+ * W = bx ay - by ax: tri_intersect from there on. For the triangles of a leaf quad
+ * (grid.cl), which computes the same values four at a time. */
+VB_INLINE int tri_finish(float ax, float ay, float az, float bx, float by, float bz, float cx,
+                         float cy, float cz, float U, float V, float W, float tmax, float *t_out,
+                         float *u_out, float *v_out)
 {
-    float3 A = ray_shear_apply(r, a4);
-    float3 B = ray_shear_apply(r, b4);
-    float3 C = ray_shear_apply(r, c4);
-    float ax = A.x, ay = A.y, bx = B.x, by = B.y, cx = C.x, cy = C.y;
-    float U = cx * by - cy * bx;
-    float V = ax * cy - ay * cx;
-    float W = bx * ay - by * ax;
 #ifdef cl_khr_fp64
     if (U == 0.0f || V == 0.0f || W == 0.0f) { /* on an edge in float: decide in double */
         U = (float)((double)cx * (double)by - (double)cy * (double)bx);
@@ -98,7 +109,7 @@ VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, 
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     float det = U + V + W;
     if (det == 0.0f) return 0;
-    float T = U * A.z + V * B.z + W * C.z;
+    float T = U * az + V * bz + W * cz;
     if (det > 0.0f) {
         if (T <= 0.0f || T > tmax * det) return 0;
     } else {
@@ -112,18 +123,34 @@ VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, 
     const float g2 = 2.0f * 5.9604645e-8f / (1.0f - 2.0f * 5.9604645e-8f);
     const float g3 = 3.0f * 5.9604645e-8f / (1.0f - 3.0f * 5.9604645e-8f);
     const float g5 = 5.0f * 5.9604645e-8f / (1.0f - 5.0f * 5.9604645e-8f);
-    float max_z = vb_max3(fabs((float3)(A.z, B.z, C.z)));
-    float max_x = vb_max3(fabs((float3)(ax, bx, cx)));
-    float max_y = vb_max3(fabs((float3)(ay, by, cy)));
+    float max_z = fmax(fabs(az), fmax(fabs(bz), fabs(cz)));
+    float max_x = fmax(fabs(ax), fmax(fabs(bx), fabs(cx)));
+    float max_y = fmax(fabs(ay), fmax(fabs(by), fabs(cy)));
     float delta_x = g5 * (max_x + max_z), delta_y = g5 * (max_y + max_z), delta_z = g3 * max_z;
     float delta_e = 2.0f * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
-    float max_e = vb_max3(fabs((float3)(U, V, W)));
+    float max_e = fmax(fabs(U), fmax(fabs(V), fabs(W)));
     float delta_t = 3.0f * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) * fabs(rcp);
     if (!(t > delta_t)) return 0;
     *t_out = t;
     *u_out = V * rcp;
     *v_out = W * rcp;
     return 1;
+}
+
+/* Intersects the sheared ray with triangle (a, b, c). On a hit with 0 < t < tmax
+ * returns 1 and writes t and the barycentric weights of b (u) and c (v). Rays through
+ * a shared edge or vertex of a closed mesh hit at least one of its triangles. */
+VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
+                            float *t_out, float *u_out, float *v_out)
+{
+    float ax, ay, az, bx, by, bz, cx, cy, cz;
+    ray_shear_apply(r, a4, &ax, &ay, &az);
+    ray_shear_apply(r, b4, &bx, &by, &bz);
+    ray_shear_apply(r, c4, &cx, &cy, &cz);
+    float U = cx * by - cy * bx;
+    float V = ax * cy - ay * cx;
+    float W = bx * ay - by * ax;
+    return tri_finish(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, tmax, t_out, u_out, v_out);
 }
 
 /* Vertex k (0, 1, 2) of a triangle, read from its own array (indexing past v0 into v1

@@ -17,14 +17,14 @@ typedef struct TraceCount {
 
 /* State of a ray walking a grid (the top level, or one top cell's sub-grid), cell by cell. */
 typedef struct GridWalk {
-    int3 cell;
-    int3 step;
-    float3 t_next;  /* ray parameter at the next cell boundary, per axis */
-    float3 t_delta; /* ray parameter across one cell, per axis */
-    float3 inv;     /* 1 / direction */
-    float t_enter;  /* where the ray enters the grid */
-    float t_leave;  /* where it leaves it (or tmax) */
-    int axis;       /* the axis of the last step (the face the ray entered the cell by); -1 */
+    int cx, cy, cz;   /* the cell */
+    int sx, sy, sz;   /* the step per axis, -1 or 1 */
+    float nx, ny, nz; /* ray parameter at the next cell boundary, per axis */
+    float dx, dy, dz; /* ray parameter across one cell, per axis */
+    float3 inv;       /* 1 / direction */
+    float t_enter;    /* where the ray enters the grid */
+    float t_leave;    /* where it leaves it (or tmax) */
+    int axis;         /* the axis of the last step (the face the ray entered the cell by); -1 */
 } GridWalk;
 
 /* The state of a closest-hit search: the best hit so far and how far a candidate may lie
@@ -35,6 +35,36 @@ typedef struct Closest {
     float window;
     float reach;
 } Closest;
+
+/* Sets a walk's cell, steps, next boundaries and deltas: the walk keeps them as scalars,
+ * as the step changes one axis at a time (vector lanes cost shuffles there on a CPU). */
+VB_INLINE void grid_walk_set(GridWalk *w, int3 c, int3 step, float3 tn, float3 td)
+{
+    w->cx = c.x;
+    w->cy = c.y;
+    w->cz = c.z;
+    w->sx = step.x;
+    w->sy = step.y;
+    w->sz = step.z;
+    w->nx = tn.x;
+    w->ny = tn.y;
+    w->nz = tn.z;
+    w->dx = td.x;
+    w->dy = td.y;
+    w->dz = td.z;
+}
+
+/* The walk's current cell. */
+VB_INLINE int3 grid_walk_cell(const GridWalk *w)
+{
+    return (int3)(w->cx, w->cy, w->cz);
+}
+
+/* Where the ray leaves the current cell. */
+VB_INLINE float grid_walk_exit(const GridWalk *w)
+{
+    return fmin(w->nx, fmin(w->ny, w->nz));
+}
 
 /* Clips the ray to the grid box and finds its first cell. Returns 0 when the ray misses
  * the grid or the part of it within (0, tmax]. */
@@ -57,11 +87,11 @@ VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir
     float3 p = org + enter * dir;
     int3 c = convert_int3_sat_rtn((p - lo) * ics);
     c = clamp(c, (int3)(0), n - 1);
-    w->cell = c;
-    w->step = select((int3)(-1), (int3)(1), isgreaterequal(dir, (float3)(0.0f)));
-    float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), w->step > 0)) * cs;
-    w->t_next = select((boundary - org) * inv, (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
-    w->t_delta = select(cs * fabs(inv), (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
+    int3 step = select((int3)(-1), (int3)(1), isgreaterequal(dir, (float3)(0.0f)));
+    float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), step > 0)) * cs;
+    float3 tb = select((boundary - org) * inv, (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
+    float3 td = select(cs * fabs(inv), (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
+    grid_walk_set(w, c, step, tb, td);
     w->inv = inv;
     w->t_enter = enter;
     w->t_leave = leave;
@@ -73,26 +103,25 @@ VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir
  * passes t_leave. */
 VB_INLINE int grid_walk_step(int3 n, GridWalk *w)
 {
-    float3 tn = w->t_next;
-    if (tn.x < tn.y && tn.x < tn.z) {
-        if (tn.x > w->t_leave) return 0;
-        w->cell.x += w->step.x;
-        w->t_next.x += w->t_delta.x;
+    if (w->nx < w->ny && w->nx < w->nz) {
+        if (w->nx > w->t_leave) return 0;
+        w->cx += w->sx;
+        w->nx += w->dx;
         w->axis = 0;
-        return w->cell.x >= 0 && w->cell.x < n.x;
+        return w->cx >= 0 && w->cx < n.x;
     }
-    if (tn.y < tn.z) {
-        if (tn.y > w->t_leave) return 0;
-        w->cell.y += w->step.y;
-        w->t_next.y += w->t_delta.y;
+    if (w->ny < w->nz) {
+        if (w->ny > w->t_leave) return 0;
+        w->cy += w->sy;
+        w->ny += w->dy;
         w->axis = 1;
-        return w->cell.y >= 0 && w->cell.y < n.y;
+        return w->cy >= 0 && w->cy < n.y;
     }
-    if (tn.z > w->t_leave) return 0;
-    w->cell.z += w->step.z;
-    w->t_next.z += w->t_delta.z;
+    if (w->nz > w->t_leave) return 0;
+    w->cz += w->sz;
+    w->nz += w->dz;
     w->axis = 2;
-    return w->cell.z >= 0 && w->cell.z < n.z;
+    return w->cz >= 0 && w->cz < n.z;
 }
 
 /* Steps to the next top cell; returns 0 when the ray leaves the grid or passes t_leave. */
@@ -127,18 +156,18 @@ VB_INLINE float3 grid_cell_lo(__constant const VbGrid *g, int3 c)
 VB_INLINE void grid_sub_begin(__constant const VbGrid *g, const GridWalk *top, int3 n, float3 org,
                               float3 dir, float t_in, float t_out, GridWalk *s)
 {
-    float3 lo = grid_cell_lo(g, top->cell);
+    float3 lo = grid_cell_lo(g, grid_walk_cell(top));
     float3 scs = vb_cload3(g->cell) / convert_float3(n);
     int3 c = clamp(convert_int3_sat_rtn((org + t_in * dir - lo) / scs), (int3)(0), n - 1);
-    int3 entry = select(n - 1, (int3)(0), top->step > 0);
+    int3 step = (int3)(top->sx, top->sy, top->sz);
+    int3 entry = select(n - 1, (int3)(0), step > 0);
     int3 face = (int3)(top->axis == 0 ? -1 : 0, top->axis == 1 ? -1 : 0, top->axis == 2 ? -1 : 0);
     c = select(c, entry, face);
-    s->cell = c;
-    s->step = top->step;
-    float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), top->step > 0)) * scs;
-    s->t_next =
+    float3 boundary = lo + convert_float3(c + select((int3)(0), (int3)(1), step > 0)) * scs;
+    float3 tn =
         select((boundary - org) * top->inv, (float3)(INFINITY), isequal(dir, (float3)(0.0f)));
-    s->t_delta = top->t_delta / convert_float3(n);
+    float3 td = (float3)(top->dx, top->dy, top->dz) / convert_float3(n);
+    grid_walk_set(s, c, step, tn, td);
     s->inv = top->inv;
     s->t_enter = t_in;
     s->t_leave = t_out;
@@ -156,6 +185,23 @@ VB_INLINE void closest_begin(Closest *c, float tmax)
     c->reach = tmax;
 }
 
+/* A hit at t (u, v) on triangle tri, offered to the closest-hit search *c: kept if it
+ * comes before the best so far (hit_before). */
+VB_INLINE void closest_offer(float3 org, float tmax, __global const VbTriangle *tris, int tri,
+                             float t, float u, float v, Closest *c)
+{
+    uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
+    if (hit_before(t, tri, opaque, c->hit, c->opaque, c->window)) {
+        c->hit.t = t;
+        c->hit.tri = tri;
+        c->hit.u = u;
+        c->hit.v = v;
+        c->opaque = opaque;
+        c->window = hit_contact_window(org, t);
+        c->reach = hit_reach(c->hit, c->opaque, c->window, tmax);
+    }
+}
+
 /* Tests triangle tri for the closest hit, updating *c (ties: the lower index, so the
  * order of the tests does not matter). */
 VB_INLINE void closest_test(const RayShear *rs, float3 org, float tmax,
@@ -163,18 +209,8 @@ VB_INLINE void closest_test(const RayShear *rs, float3 org, float tmax,
 {
     float t, u, v;
     if (tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                      tri_vertex(tris, tri, 2), c->reach, &t, &u, &v)) {
-        uint opaque = tri_tag(tris, tri) & VBCL_TAG_OPAQUE;
-        if (hit_before(t, tri, opaque, c->hit, c->opaque, c->window)) {
-            c->hit.t = t;
-            c->hit.tri = tri;
-            c->hit.u = u;
-            c->hit.v = v;
-            c->opaque = opaque;
-            c->window = hit_contact_window(org, t);
-            c->reach = hit_reach(c->hit, c->opaque, c->window, tmax);
-        }
-    }
+                      tri_vertex(tris, tri, 2), c->reach, &t, &u, &v))
+        closest_offer(org, tmax, tris, tri, t, u, v, c);
 }
 
 /* Whether triangle tri lies on the ray before tmax (not when its tag has a bit of `skip`,
@@ -201,39 +237,74 @@ VB_INLINE float4 vb_comp4(float4 x, float4 y, float4 z, uint k)
 VB_INLINE void quad_shear_vertex(const RayShear *rs, __global const VbLeafQuad *q, int k, float4 *x,
                                  float4 *y, float4 *z)
 {
-    float4 px = vload4(0, q->xyz[3 * k]) - rs->org.x;
-    float4 py = vload4(0, q->xyz[3 * k + 1]) - rs->org.y;
-    float4 pz = vload4(0, q->xyz[3 * k + 2]) - rs->org.z;
-    float4 qx = vb_comp4(px, py, pz, rs->perm.x);
-    float4 qy = vb_comp4(px, py, pz, rs->perm.y);
-    float4 qz = vb_comp4(px, py, pz, rs->perm.z);
+    float4 px = vload4(0, q->xyz[3 * k]) - rs->ox;
+    float4 py = vload4(0, q->xyz[3 * k + 1]) - rs->oy;
+    float4 pz = vload4(0, q->xyz[3 * k + 2]) - rs->oz;
+    float4 qx = vb_comp4(px, py, pz, rs->kx);
+    float4 qy = vb_comp4(px, py, pz, rs->ky);
+    float4 qz = vb_comp4(px, py, pz, rs->kz);
     *x = qx - rs->sx * qz;
     *y = qy - rs->sy * qz;
     *z = rs->sz * qz;
 }
 
+/* A quad's four triangles through the ray's shear, and their edge functions. */
+typedef struct QuadShear {
+    float4 ax, ay, az, bx, by, bz, cx, cy, cz;
+    float4 U, V, W;
+} QuadShear;
+
 /* The lanes of a quad that tri_intersect could accept within tmax (-1 per lane; padding
  * lanes included, the caller masks them): tri_intersect's edge-sign and distance tests on
- * all four triangles at once in float4 lanes. A lane is left out only where tri_intersect,
- * computing the same values, rejects it too: with an edge function of exactly 0 (which
- * tri_intersect decides again in double) or a NaN the lane stays in. The caller runs
- * tri_intersect on the lanes left, so the hits are those of testing every triangle alone. */
-VB_INLINE int4 quad_candidates(const RayShear *rs, __global const VbLeafQuad *q, float tmax)
+ * all four triangles at once in float4 lanes, whose values are kept in *qs. A lane is left
+ * out only where tri_intersect, computing the same values, rejects it too: with an edge
+ * function of exactly 0 (which tri_intersect decides again in double) or a NaN the lane
+ * stays in. The caller finishes the test of the lanes left on their values (quad_lane_hit),
+ * so the hits are those of testing every triangle alone. */
+VB_INLINE int4 quad_candidates(const RayShear *rs, __global const VbLeafQuad *q, float tmax,
+                               QuadShear *qs)
 {
-    float4 ax, ay, az, bx, by, bz, cx, cy, cz;
-    quad_shear_vertex(rs, q, 0, &ax, &ay, &az);
-    quad_shear_vertex(rs, q, 1, &bx, &by, &bz);
-    quad_shear_vertex(rs, q, 2, &cx, &cy, &cz);
+    quad_shear_vertex(rs, q, 0, &qs->ax, &qs->ay, &qs->az);
+    quad_shear_vertex(rs, q, 1, &qs->bx, &qs->by, &qs->bz);
+    quad_shear_vertex(rs, q, 2, &qs->cx, &qs->cy, &qs->cz);
+    float4 ax = qs->ax, ay = qs->ay, bx = qs->bx, by = qs->by, cx = qs->cx, cy = qs->cy;
     float4 U = cx * by - cy * bx;
     float4 V = ax * cy - ay * cx;
     float4 W = bx * ay - by * ax;
+    qs->U = U;
+    qs->V = V;
+    qs->W = W;
     int4 zero = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
     int4 mixed = ((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f));
     float4 det = U + V + W;
-    float4 T = U * az + V * bz + W * cz;
+    float4 T = U * qs->az + V * qs->bz + W * qs->cz;
     float4 lim = tmax * det;
     int4 outside = select((T >= 0.0f) | (T < lim), (T <= 0.0f) | (T > lim), det > 0.0f);
     return zero | ~(mixed | outside);
+}
+
+/* Lane l (0 .. 3, a constant where it is called) of v. */
+VB_INLINE float vb_lane4(float4 v, int l)
+{
+    return l == 0 ? v.s0 : (l == 1 ? v.s1 : (l == 2 ? v.s2 : v.s3));
+}
+
+/* tri_intersect of the triangle in lane l of a quad within tmax, finished from the values
+ * quad_candidates kept: no second read of the triangle, no second shear. */
+VB_INLINE int quad_lane_hit(const QuadShear *qs, int l, float tmax, float *t, float *u, float *v)
+{
+    return tri_finish(vb_lane4(qs->ax, l), vb_lane4(qs->ay, l), vb_lane4(qs->az, l),
+                      vb_lane4(qs->bx, l), vb_lane4(qs->by, l), vb_lane4(qs->bz, l),
+                      vb_lane4(qs->cx, l), vb_lane4(qs->cy, l), vb_lane4(qs->cz, l),
+                      vb_lane4(qs->U, l), vb_lane4(qs->V, l), vb_lane4(qs->W, l), tmax, t, u, v);
+}
+
+/* closest_test of triangle tri, in lane l of a quad. */
+VB_INLINE void closest_lane(const QuadShear *qs, int l, float3 org, float tmax,
+                            __global const VbTriangle *tris, int tri, Closest *c)
+{
+    float t, u, v;
+    if (quad_lane_hit(qs, l, c->reach, &t, &u, &v)) closest_offer(org, tmax, tris, tri, t, u, v, c);
 }
 
 /* The triangles of a quad, one index per lane (-1: padding). */
@@ -249,8 +320,8 @@ VB_INLINE uint vb_count4(int4 m)
 }
 
 /* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
- * four at a time (quad_candidates) and then alone where the quad's test leaves them in,
- * updating *c. Returns the number of triangles tested. */
+ * four at a time (quad_candidates) and then each lane the quad's test leaves in on its own
+ * (quad_lane_hit), updating *c. Returns the number of triangles tested. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
                                  __global const VbTriangle *tris, __global const uint *leaf_start,
                                  __global const VbLeafQuad *quads, uint leaf, Closest *c)
@@ -259,18 +330,14 @@ VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
     for (uint k = begin; k < end; k++) {
         __global const VbLeafQuad *q = quads + k;
         int4 id = quad_ids(q);
-        if (id.s1 < 0) { /* one triangle: tested alone */
-            n++;
-            closest_test(rs, org, tmax, tris, id.s0, c);
-            continue;
-        }
         int4 real = id >= 0;
         n += vb_count4(real);
-        int4 cand = quad_candidates(rs, q, c->reach) & real;
-        if (cand.s0) closest_test(rs, org, tmax, tris, id.s0, c);
-        if (cand.s1) closest_test(rs, org, tmax, tris, id.s1, c);
-        if (cand.s2) closest_test(rs, org, tmax, tris, id.s2, c);
-        if (cand.s3) closest_test(rs, org, tmax, tris, id.s3, c);
+        QuadShear qs;
+        int4 cand = quad_candidates(rs, q, c->reach, &qs) & real;
+        if (cand.s0) closest_lane(&qs, 0, org, tmax, tris, id.s0, c);
+        if (cand.s1) closest_lane(&qs, 1, org, tmax, tris, id.s1, c);
+        if (cand.s2) closest_lane(&qs, 2, org, tmax, tris, id.s2, c);
+        if (cand.s3) closest_lane(&qs, 3, org, tmax, tris, id.s3, c);
     }
     return n;
 }
@@ -295,8 +362,8 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
     float t_in = w.t_enter;
     do {
         steps++;
-        VbGridCell gc = cells[grid_cell_index(g, w.cell)];
-        float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
+        VbGridCell gc = cells[grid_cell_index(g, grid_walk_cell(&w))];
+        float cell_exit = grid_walk_exit(&w);
         if (gc.res == VBCL_GRID_LIST) {
             tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_quads, gc.first, &c);
         } else {
@@ -305,9 +372,9 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
             grid_sub_begin(g, &w, n, org, dir, t_in, fmin(cell_exit, w.t_leave), &s);
             do {
                 steps++;
-                uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
+                uint leaf = gc.first + (uint)(s.cx + n.x * (s.cy + n.y * s.cz));
                 tests += grid_leaf_closest(&rs, org, tmax, tris, leaf_start, leaf_quads, leaf, &c);
-                float sub_exit = fmin(s.t_next.x, fmin(s.t_next.y, s.t_next.z));
+                float sub_exit = grid_walk_exit(&s);
                 if (c.hit.tri >= 0 && c.reach <= fmin(sub_exit, cell_exit)) break;
             } while (grid_walk_step(n, &s));
         }
@@ -320,8 +387,8 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
 }
 
 /* Whether any triangle of one leaf lies on the ray before tmax, those whose tag has a bit
- * of `skip` not counted; adds the tests to *tests (a quad's real lanes; a skipped texture
- * quad none). */
+ * of `skip` (VBCL_TAG_TEXTURE or 0) not counted; adds the tests to *tests (a quad's real
+ * lanes; a skipped texture quad none). */
 VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
                             __global const uint *leaf_start, __global const VbLeafQuad *quads,
                             uint leaf, uint skip, uint *tests)
@@ -332,18 +399,15 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
         int4 id = quad_ids(q);
         /* the real lanes of a quad share VBCL_TAG_TEXTURE (pack_leaf_quads), lane 0 is real */
         if ((skip & tri_tag(tris, id.s0) & VBCL_TAG_TEXTURE) != 0u) continue;
-        if (id.s1 < 0) { /* one triangle: tested alone */
-            if (any_test(rs, tmax, tris, id.s0, skip, tests)) return 1;
-            continue;
-        }
         int4 real = id >= 0;
         *tests += vb_count4(real);
-        int4 cand = quad_candidates(rs, q, tmax) & real;
-        uint dummy = 0; /* the quad's triangles are counted above */
-        if ((cand.s0 && any_test(rs, tmax, tris, id.s0, skip, &dummy)) ||
-            (cand.s1 && any_test(rs, tmax, tris, id.s1, skip, &dummy)) ||
-            (cand.s2 && any_test(rs, tmax, tris, id.s2, skip, &dummy)) ||
-            (cand.s3 && any_test(rs, tmax, tris, id.s3, skip, &dummy)))
+        QuadShear qs;
+        int4 cand = quad_candidates(rs, q, tmax, &qs) & real;
+        float t, u, v;
+        if ((cand.s0 && quad_lane_hit(&qs, 0, tmax, &t, &u, &v)) ||
+            (cand.s1 && quad_lane_hit(&qs, 1, tmax, &t, &u, &v)) ||
+            (cand.s2 && quad_lane_hit(&qs, 2, tmax, &t, &u, &v)) ||
+            (cand.s3 && quad_lane_hit(&qs, 3, tmax, &t, &u, &v)))
             return 1;
     }
     return 0;
@@ -365,8 +429,8 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
     float t_in = w.t_enter;
     do {
         steps++;
-        VbGridCell gc = cells[grid_cell_index(g, w.cell)];
-        float cell_exit = fmin(w.t_next.x, fmin(w.t_next.y, w.t_next.z));
+        VbGridCell gc = cells[grid_cell_index(g, grid_walk_cell(&w))];
+        float cell_exit = grid_walk_exit(&w);
         if (gc.res == VBCL_GRID_LIST) {
             blocked =
                 grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_quads, gc.first, skip, &tests);
@@ -376,7 +440,7 @@ VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriang
             grid_sub_begin(g, &w, n, org, dir, t_in, fmin(cell_exit, w.t_leave), &s);
             do {
                 steps++;
-                uint leaf = gc.first + (uint)(s.cell.x + n.x * (s.cell.y + n.y * s.cell.z));
+                uint leaf = gc.first + (uint)(s.cx + n.x * (s.cy + n.y * s.cz));
                 blocked =
                     grid_leaf_any(&rs, tmax, tris, leaf_start, leaf_quads, leaf, skip, &tests);
             } while (!blocked && grid_walk_step(n, &s));
