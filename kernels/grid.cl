@@ -66,17 +66,17 @@ VB_INLINE float grid_walk_exit(const GridWalk *w)
     return fmin(w->nx, fmin(w->ny, w->nz));
 }
 
-/* Clips the ray to the grid box and finds its first cell. Returns 0 when the ray misses
- * the grid or the part of it within (0, tmax]. */
-VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, float tmax,
-                              GridWalk *w)
+/* Clips the ray's stretch [tmin, tmax] (tmin >= 0) to the grid box and finds its first
+ * cell. Returns 0 when the stretch misses the grid. */
+VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, float tmin,
+                              float tmax, GridWalk *w)
 {
     float3 lo = vb_cload3(g->lo), hi = vb_cload3(g->hi);
     float3 inv = (float3)(1.0f) / dir; /* +-inf for zero components */
     float3 t0 = (lo - org) * inv, t1 = (hi - org) * inv;
     float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
     /* NaN (0 * inf, a ray in a slab plane) must not narrow the interval */
-    float enter = fmax(0.0f, fmax(isnan(tn.x) ? 0.0f : tn.x,
+    float enter = fmax(tmin, fmax(isnan(tn.x) ? 0.0f : tn.x,
                                   fmax(isnan(tn.y) ? 0.0f : tn.y, isnan(tn.z) ? 0.0f : tn.z)));
     float leave =
         fmin(tmax, fmin(isnan(tf.x) ? INFINITY : tf.x,
@@ -342,21 +342,21 @@ VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
     return n;
 }
 
-/* Closest hit of the ray (org, dir) with 0 < t <= tmax. A hit found in a cell (a sub-cell
- * where the top cell has a sub-grid) is accepted only if it (and the window in which an
- * opaque surface in contact would still come first, hit_before) lies before that cell's
- * exit, so a triangle that also spans later cells cannot hide a closer one there. Ties go
- * to the lower triangle index. */
-VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
-                                   __global const VbGridCell *cells,
-                                   __global const uint *leaf_start,
-                                   __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
-                                   float tmax, TraceCount *count)
+/* The closest-hit search *cp (hits with 0 < t <= tmax) carried on through the cells that
+ * the ray's stretch span (within [0, tmax]) crosses: a search begun on some triangles
+ * alone goes on in the grid where only the grid can say. A hit found in a cell (a
+ * sub-cell where the top cell has a sub-grid) is accepted only if it (and the window in
+ * which an opaque surface in contact would still come first, hit_before) lies before that
+ * cell's exit, so a triangle that also spans later cells cannot hide a closer one there.
+ * Ties go to the lower triangle index. */
+VB_INLINE void grid_walk_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
+                                 __global const VbGridCell *cells, __global const uint *leaf_start,
+                                 __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
+                                 float2 span, float tmax, Closest *cp, TraceCount *count)
 {
-    Closest c;
-    closest_begin(&c, tmax);
+    Closest c = *cp;
     GridWalk w;
-    if (!grid_walk_begin(g, org, dir, tmax, &w)) return c.hit;
+    if (!grid_walk_begin(g, org, dir, span.x, span.y, &w)) return;
     RayShear rs = ray_shear_make(org, dir);
     uint steps = 0, tests = 0;
     float t_in = w.t_enter;
@@ -383,6 +383,20 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
     } while (grid_walk_next(g, &w));
     count->steps += steps;
     count->tests += tests;
+    *cp = c;
+}
+
+/* Closest hit of the ray (org, dir) with 0 < t <= tmax, through the grid. */
+VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const VbTriangle *tris,
+                                   __global const VbGridCell *cells,
+                                   __global const uint *leaf_start,
+                                   __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
+                                   float tmax, TraceCount *count)
+{
+    Closest c;
+    closest_begin(&c, tmax);
+    grid_walk_closest(g, tris, cells, leaf_start, leaf_quads, org, dir, (float2)(0.0f, tmax), tmax,
+                      &c, count);
     return c.hit;
 }
 
@@ -414,15 +428,16 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow
- * feeler: the first occluder ends the walk); triangles whose tag has a bit of `skip`
- * (VBCL_TAG_TEXTURE, or 0) are not occluders. */
+ * feeler: the first occluder ends the walk) in the cells the stretch span (within
+ * [0, tmax]) crosses; triangles whose tag has a bit of `skip` (VBCL_TAG_TEXTURE, or 0) are
+ * not occluders. */
 VB_INLINE int grid_trace_any(__constant const VbGrid *g, __global const VbTriangle *tris,
                              __global const VbGridCell *cells, __global const uint *leaf_start,
                              __global const VbLeafQuad *leaf_quads, float3 org, float3 dir,
-                             float tmax, uint skip, TraceCount *count)
+                             float2 span, float tmax, uint skip, TraceCount *count)
 {
     GridWalk w;
-    if (!grid_walk_begin(g, org, dir, tmax, &w)) return 0;
+    if (!grid_walk_begin(g, org, dir, span.x, span.y, &w)) return 0;
     RayShear rs = ray_shear_make(org, dir);
     uint steps = 0, tests = 0;
     int blocked = 0;

@@ -242,6 +242,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
     os->n = 0;
     os->tris = 0u;
     os->nbig = 0;
+    os->walk = 0;
     LightCone k;
     k.o = ls->origin;
     k.axis = ls->to_c / ls->d;
@@ -308,10 +309,14 @@ VB_INLINE float3 light_feeler_decided(const DevScene *scn, const ShadePoint *sp,
         return light_feeler_open(scn, sp, t);
     }
     sc->traced++;
-    ObjectSet grid;
-    grid.n = -1;
-    grid.sole = os->sole; /* the set is whole: only a big record's bounds send it to the grid */
-    return light_feeler(scn, sp, need == OBJECT_SET_GRID ? &grid : os, origin, w, t, tc);
+    if (need == OBJECT_SET_GRID && os->n >= 0) {
+        /* the set is whole: only a big record's bounds send it to the grid, and only where
+         * the feeler lies in them */
+        ObjectSet walk = *os;
+        walk.walk = 1;
+        return light_feeler(scn, sp, &walk, origin, w, t, tc);
+    }
+    return light_feeler(scn, sp, os, origin, w, t, tc);
 }
 
 /* Whether the BRDF gives direction w anything: a diffuse term, or w inside the specular

@@ -218,15 +218,17 @@ VB_INLINE float3 probe_cap_feeler(const ProbeCap *cap, int i, int k)
  * bits 0-1 what light_cone_objects says (0: the grid, 1: clear, 2: a set of triangles
  * alone; 3: the point is inside the light, no test), bit 2 set where the set (or clear
  * cone) has big objects or texture parts whose bounds each feeler tests, bit 3 where some feeler
- * met such bounds (and walks the grid, not checked here), bit 4 where some feeler passed through a
- * solid part's core (not traced in a render: its walk through the grid, run here, must let nothing
- * through), bits 5-15 how many of nrays feelers spread over the light's cap (uniform in solid
- * angle, 8 on its rim; those leaving the surface's front only, each to the near side of the sphere)
- * the brute force (or for the blocked ones, the walk) contradicts: for a clear cone, feelers that
- * meet a triangle, every triangle tested; for a set, feelers whose closest hit among the set's
- * triangles (scene_trace_closest_in) is not the closest of all triangles (the same test, ties to
- * the lower index; the big parts' left out, but a feeler that meets one inside its host is wrong),
- * bits 16-31 such a feeler's triangle (clear) or its brute-force hit + 1 (set). */
+ * met such bounds (and walks the grid where it lies in them), bit 4 where some feeler passed
+ * through a solid part's core (not traced in a render: its walk through the grid, run here, must
+ * let nothing through), bits 5-15 how many of nrays feelers spread over the light's cap (uniform in
+ * solid angle, 8 on its rim; those leaving the surface's front only, each to the near side of the
+ * sphere) the brute force (or for the blocked ones, the walk) contradicts: for a clear cone,
+ * feelers that meet a triangle, every triangle tested; for a set, feelers whose closest hit among
+ * the set's triangles (scene_trace_closest_in) is not the closest of all triangles (the same test,
+ * ties to the lower index; the big parts' left out, but a feeler that meets one inside its host is
+ * wrong), and for a feeler that meets a big record's bounds, one whose closest or any hit through
+ * the set and the grid over object_set_span differs from the whole walk's (bit for bit), bits 16-31
+ * such a feeler's triangle (clear) or its hit + 1 (set). */
 __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
                                __global uint *out)
 {
@@ -256,7 +258,19 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
                                                        sp.medium.tex_counts == 0u)
                                    : OBJECT_SET_ALONE;
             if (need == OBJECT_SET_GRID) {
-                big++; /* this feeler walks the grid, as a render's does */
+                /* this feeler walks the grid where it lies in the big records' bounds, as a
+                 * render's does: the same closest and any hit as a walk of its whole way */
+                big++;
+                ObjectSet walk = os;
+                walk.walk = 1;
+                TraceCount tc = {0, 0};
+                VbHit h = scene_trace_closest_in(&sc, &walk, ls.origin, w, t_light, &tc);
+                VbHit g = scene_trace_closest(&sc, ls.origin, w, t_light, &tc);
+                int bad = h.tri != g.tri || (h.tri >= 0 && h.t != g.t) ||
+                          scene_trace_any_in(&sc, &walk, ls.origin, w, t_light, 0u, &tc) !=
+                              scene_trace_any(&sc, ls.origin, w, t_light, 0u, &tc);
+                if (bad && !wrong) which = (uint)(g.tri + 1);
+                wrong += bad ? 1u : 0u;
                 continue;
             }
 #ifdef VBCL_HAS_TRANSPARENCY

@@ -59,7 +59,7 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
                               TraceCount *tc)
 {
     return grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_quads,
-                          org, dir, tmax, skip, tc);
+                          org, dir, (float2)(0.0f, tmax), tmax, skip, tc);
 }
 
 /* A few ranges of triangles, the only ones a ray may meet (the shadow cone test,
@@ -79,21 +79,32 @@ typedef struct ObjectSet {
     int sole; /* the host that all the set holds (ranges and big records) belongs to, where
                * its own triangles bound a convex volume (VBCL_OBJECT_CONVEX or _HULL; its
                * texture may reach out), or -1: a feeler that leaves it meets nothing more */
+    int walk; /* 1: the big records' triangles too, through the grid where the ray lies in
+               * their bounding spheres (object_set_span); 0: the ranges alone */
 } ObjectSet;
 
-/* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
- * bounding sphere of record ob (conservative: margins as the cone test's). */
-VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
+/* Where the line from org along the unit dir lies in the bounding sphere of record ob,
+ * widened by margins as the cone test's (1e-5 of the distances, reach the farthest one
+ * along the line that matters): (in, out), or (inf, -inf) where it misses the sphere. */
+VB_INLINE float2 object_chord(__global const VbObject *ob, float3 org, float3 dir, float reach)
 {
     float4 b = vload4(0, ob->bound);
     float3 v = b.xyz - org;
     float along = dot(v, dir);
     float3 q = v - along * dir;
-    float m = b.w + 1e-5f * (fabs(st.y) + length(v) + b.w);
+    float m = b.w + 1e-5f * (fabs(reach) + length(v) + b.w);
     float h2 = m * m - dot(q, q);
-    if (h2 < 0.0f) return 0;
+    if (h2 < 0.0f) return (float2)(INFINITY, -INFINITY);
     float h = sqrt(h2);
-    return along - h <= st.y && along + h >= st.x;
+    return (float2)(along - h, along + h);
+}
+
+/* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
+ * bounding sphere of record ob (conservative: margins as the cone test's). */
+VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
+{
+    float2 c = object_chord(ob, org, dir, st.y);
+    return c.x <= st.y && c.y >= st.x;
 }
 
 /* Whether the segment from org along the unit dir to distance t can meet the bounding
@@ -101,6 +112,22 @@ VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, floa
 VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, float3 dir, float t)
 {
     return object_stretch_meets(ob, org, dir, (float2)(0.0f, t));
+}
+
+/* The stretch of the segment from org along the unit dir to distance t that holds every
+ * point where it lies in the bounding sphere of one of the set's big records (margins as
+ * object_stretch_meets); x > y where it meets none. All of a big record's triangles lie
+ * in its sphere, and the cone test has shown that no triangle outside the set can meet
+ * the segment: the grid need be walked only there. */
+VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+                                 float t)
+{
+    float2 span = (float2)(INFINITY, -INFINITY);
+    for (int k = 0; k < os->nbig; k++) {
+        float2 c = object_chord(sc->objects + os->big[k], org, dir, t);
+        span = (float2)(fmin(span.x, c.x), fmax(span.y, c.y));
+    }
+    return (float2)(fmax(span.x, 0.0f), fmin(span.y, t));
 }
 
 /* Whether the segment from org along the unit dir to distance t passes through the core
@@ -211,7 +238,9 @@ VB_INLINE int object_set_big(ObjectSet *os, uint rec)
 }
 
 /* scene_trace_closest among the set's triangles alone: each of them tested (the
- * same test and the same order of hits as the grid's, ties to the lower index), no walk. */
+ * same test and the same order of hits as the grid's, ties to the lower index), and with
+ * os->walk the grid over object_set_span, which finds the big records' triangles (and the
+ * ranges' again, which changes nothing). */
 VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, float3 org,
                                        float3 dir, float tmax, TraceCount *tc)
 {
@@ -224,10 +253,17 @@ VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, 
             closest_test(&rs, org, tmax, sc->tris, (int)t, &c);
         tc->tests += os->count[k];
     }
+    if (os->walk) {
+        float2 span = object_set_span(sc, os, org, dir, tmax);
+        if (span.x <= span.y)
+            grid_walk_closest(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start,
+                              sc->leaf_quads, org, dir, span, tmax, &c, tc);
+    }
     return c.hit;
 }
 
-/* scene_trace_any among the set's triangles alone. */
+/* scene_trace_any among the set's triangles alone, and with os->walk the grid over
+ * object_set_span. */
 VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
                                  float tmax, uint skip, TraceCount *tc)
 {
@@ -236,7 +272,11 @@ VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3
     for (int k = 0; k < os->n; k++)
         for (uint t = os->first[k]; t < os->first[k] + os->count[k]; t++)
             if (any_test(&rs, tmax, sc->tris, (int)t, skip, &tc->tests)) return 1;
-    return 0;
+    if (!os->walk) return 0;
+    float2 span = object_set_span(sc, os, org, dir, tmax);
+    return span.x <= span.y &&
+           grid_trace_any(&sc->f->grid, sc->tris, sc->grid_cells, sc->leaf_start, sc->leaf_quads,
+                          org, dir, span, tmax, skip, tc);
 }
 
 /* Material of an opaque-scene triangle: its object's own material. */

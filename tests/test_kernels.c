@@ -541,7 +541,9 @@ static unsigned *run_cone_probe(Fixture *fx, const char *kernel, int ncases, int
  * hit among them is every feeler's closest hit of all, the big spheres' triangles aside,
  * which such a feeler may meet only outside the prism (where they change nothing), and a
  * feeler kept off the grid beside the sphere or the vase (objects of more than 16 triangles,
- * whose bounding spheres each feeler tests) must miss them; such
+ * whose bounding spheres each feeler tests) must miss them, and one that meets their bounds,
+ * traced through the set and the grid only where it lies in them (object_set_span), must get
+ * the closest and the any hit of a walk of its whole way, bit for bit; such
  * sets must also come from points on the texture's spheres (the prism's triangles without
  * the spheres the cone misses). Feelers that pass through the core of a solid sphere,
  * which a render does not trace, must meet that sphere and, where the probe knows their
