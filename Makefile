@@ -34,20 +34,28 @@ CPPFLAGS := $(HOST_INC) -Ikernels $(PKG_CFLAGS) $(MPI_CFLAGS) -MMD -MP
 CFLAGS   := $(CSTD) $(OPT) $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -Wshadow $(SANFLAGS)
 LDFLAGS  := $(SANFLAGS)
-LDLIBS   := $(PKG_LIBS) $(MPI_LIBS) -lm -pthread
+LDLIBS   := $(PKG_LIBS) $(OIIO_LIBS) $(MPI_LIBS) -lm -pthread
+# vbcl itself does not link OpenImageIO: it loads it as a plugin (host/util/image_plugin.c).
+VBCL_LDLIBS := $(PKG_LIBS) $(MPI_LIBS) -lm -pthread -ldl
 
 HOST_C   := $(wildcard host/*.c host/*/*.c)
+PLUGIN_LOADER := host/util/image_plugin.c
 HOST_CXX := $(wildcard host/*.cpp host/*/*.cpp)
-LIB_OBJ  := $(patsubst host/%.c,$(BUILD)/host/%.o,$(filter-out host/main.c,$(HOST_C))) \
+LIB_OBJ  := $(patsubst host/%.c,$(BUILD)/host/%.o,$(filter-out host/main.c $(PLUGIN_LOADER),$(HOST_C))) \
             $(patsubst host/%.cpp,$(BUILD)/host/%.o,$(HOST_CXX)) $(BUILD)/kernel_source.o
 MAIN_OBJ := $(BUILD)/host/main.o
+# The vbcl binary: the library without OpenImageIO's file, the plugin's loader, and the
+# plugin (image_io.cpp and image_path.c as a shared object) embedded.
+PLUGIN_SRC := host/util/image_io.cpp host/util/image_path.c
+VBCL_OBJ := $(MAIN_OBJ) $(filter-out $(BUILD)/host/util/image_io.o,$(LIB_OBJ)) \
+            $(BUILD)/host/util/image_plugin.o $(BUILD)/image_plugin_blob.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
 .PHONY: all run test deps format format-check clean bench bench-grid gallery stress oclgrind fuzz FORCE test-drivers
 all: vbcl
 
-build/config.mk: scripts/install-deps.sh
+build/config.mk: scripts/install-deps.sh Makefile
 	@mkdir -p build
 	$(Q)if ! pkg-config --exists OpenCL libcjson OpenImageIO 2>/dev/null || \
 	      ! ls /etc/OpenCL/vendors/*.icd >/dev/null 2>&1; then \
@@ -56,7 +64,8 @@ build/config.mk: scripts/install-deps.sh
 	$(Q)pkg-config --exists OpenCL libcjson OpenImageIO || \
 	    { echo "vbcl: pkg-config still cannot find OpenCL, libcjson, OpenImageIO" >&2; exit 1; }
 	$(Q){ echo "PKG_CFLAGS := $$(pkg-config --cflags OpenCL libcjson OpenImageIO)"; \
-	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson OpenImageIO)"; \
+	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson)"; \
+	      echo "OIIO_LIBS := $$(pkg-config --libs OpenImageIO)"; \
 	      if pkg-config --exists ompi-c 2>/dev/null; then \
 	        echo "MPI_CFLAGS := -DVBCL_MPI $$(pkg-config --cflags ompi-c)"; \
 	        echo "MPI_LIBS := $$(pkg-config --libs ompi-c)"; \
@@ -74,9 +83,31 @@ vbcl: $(BUILD)/vbcl
 	@echo "sanitized binary: $(BUILD)/vbcl (./vbcl is left as the plain build)"
 endif
 
-$(BUILD)/vbcl: $(MAIN_OBJ) $(LIB_OBJ)
+$(BUILD)/vbcl: $(VBCL_OBJ)
 	@echo "  LINK    $@"
-	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(VBCL_LDLIBS)
+
+$(BUILD)/plugin/%.o: host/util/%.cpp build/config.mk
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $< (plugin)"
+	$(Q)$(CXX) $(CPPFLAGS) $(CXXFLAGS) -fPIC -c -o $@ $<
+
+$(BUILD)/plugin/%.o: host/util/%.c build/config.mk
+	@mkdir -p $(dir $@)
+	@echo "  CC      $< (plugin)"
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) -fPIC -c -o $@ $<
+
+$(BUILD)/libvbcl_image.so: $(patsubst host/util/%,$(BUILD)/plugin/%.o,$(basename $(PLUGIN_SRC)))
+	@echo "  LINK    $@"
+	$(Q)$(CXX) $(LDFLAGS) -shared -o $@ $^ $(OIIO_LIBS)
+
+# The plugin's bytes in the binary, as vbcl_image_plugin .. vbcl_image_plugin_end.
+$(BUILD)/image_plugin_blob.o: $(BUILD)/libvbcl_image.so
+	@echo "  EMBED   $<"
+	$(Q)printf '%s\n' '.section .rodata' '.balign 64' '.globl vbcl_image_plugin' \
+	    'vbcl_image_plugin:' '.incbin "$<"' '.globl vbcl_image_plugin_end' \
+	    'vbcl_image_plugin_end:' '.section .note.GNU-stack,"",@progbits' > $(BUILD)/image_plugin_blob.s
+	$(Q)$(CC) -c -o $@ $(BUILD)/image_plugin_blob.s
 
 $(BUILD)/vbcl-tests: $(TEST_OBJ) $(LIB_OBJ)
 	@echo "  LINK    $@"

@@ -736,7 +736,10 @@ static int run(Dist *d, int argc, char **argv, double t0)
     if (!rc) {
         const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
         rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
-        if (rc) diag_print(prog, "%s", err);
+        if (rc)
+            diag_print(prog, "%s", err);
+        else
+            image_preload();    /* OpenImageIO loads while the kernels are built and run */
         rc = dist_agree(d, rc); /* every rank has its devices, or all stop */
     }
     if (!rc) {

@@ -89,6 +89,34 @@ static void test_cli_help_and_usage(void)
     CHECK(vbcl("scene.json --width 0", out, sizeof out) == 2, "width 0 rejected");
 }
 
+/* vbcl loads OpenImageIO only to read or write an image, from the plugin embedded in it
+ * (host/util/image_plugin.c): the binary does not link it, --help does not load it, and a
+ * render loads it and writes its PNG. */
+static void test_cli_image_plugin(void)
+{
+    static char out[1 << 18];
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "ldd %s", tu_vbcl);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "libOpenCL") &&
+              !strstr(out, "libOpenImageIO"),
+          "vbcl does not link OpenImageIO: %s", out);
+    snprintf(cmd, sizeof cmd, "LD_DEBUG=files %s --help", tu_vbcl);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "usage: vbcl") &&
+              !strstr(out, "libOpenImageIO"),
+          "--help loads no OpenImageIO");
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    const char *scene = tu_write_file("plugin.json", GOOD_SCENE);
+    char img[512];
+    snprintf(img, sizeof img, "%s/plugin.png", tu_tmpdir());
+    snprintf(cmd, sizeof cmd, "LD_DEBUG=files timeout 300 %s %s -q -o %s --width 8 --height 8",
+             tu_vbcl, scene, img);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "libOpenImageIO") && file_exists(img),
+          "a render loads OpenImageIO and writes %s", img);
+}
+
 static void test_cli_list_devices(void)
 {
     char out[8192];
@@ -724,6 +752,7 @@ static void test_cli_stats_json(void)
 void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
+    RUN_TEST(test_cli_image_plugin);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);

@@ -1,8 +1,10 @@
-// image_io.cpp — the one C++ file: OpenImageIO behind the C interface of image_io.h.
+// image_io.cpp — the one C++ file: OpenImageIO behind the C interface of image_io.h. The
+// vbcl binary loads it as a plugin (image_plugin.c); the tests and tools link it.
 #include "image_io.h"
 
 #include <OpenImageIO/imageio.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,32 +14,6 @@
 #include <vector>
 
 using namespace OIIO;
-
-static std::string lower_ext(const char *path)
-{
-    const char *dot = std::strrchr(path, '.');
-    const char *slash = std::strrchr(path, '/');
-    if (!dot || (slash && dot < slash)) return "";
-    std::string e(dot + 1);
-    for (auto &ch : e) ch = (char)std::tolower((unsigned char)ch);
-    return e;
-}
-
-static bool is_float_format(const std::string &e)
-{
-    return e == "exr";
-}
-
-extern "C" int image_check_path(const char *path, char *err, size_t errlen)
-{
-    std::string e = lower_ext(path);
-    if (e == "png" || e == "jpg" || e == "jpeg" || e == "tif" || e == "tiff" || e == "exr")
-        return 0;
-    std::snprintf(err, errlen,
-                  "%s: unknown image format \"%s\" (expected .png, .jpg, .tif or .exr)", path,
-                  e.c_str());
-    return -1;
-}
 
 static float srgb_encode(float v)
 {
@@ -50,7 +26,9 @@ extern "C" int image_write(const char *path, int width, int height, const float 
                            float exposure, char *err, size_t errlen)
 {
     if (image_check_path(path, err, errlen)) return -1;
-    std::string e = lower_ext(path);
+    const char *dot = std::strrchr(path, '.'); // image_check_path found an extension
+    std::string e(dot + 1);
+    for (auto &ch : e) ch = (char)std::tolower((unsigned char)ch);
     std::string p(path);
     size_t slash = p.rfind('/');
     std::string dir = slash == std::string::npos ? "" : p.substr(0, slash + 1);
@@ -59,7 +37,7 @@ extern "C" int image_write(const char *path, int width, int height, const float 
 
     const float scale = std::exp2(exposure);
     const size_t n = (size_t)width * (size_t)height;
-    bool flt = is_float_format(e);
+    bool flt = image_is_float_format(path) != 0;
     std::vector<float> fpix;
     std::vector<unsigned char> bpix;
     if (flt)

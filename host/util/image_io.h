@@ -12,6 +12,15 @@ extern "C" {
 /* Returns 0 when path's extension names a format vbcl writes, else -1 with a message. */
 int image_check_path(const char *path, char *err, size_t errlen);
 
+/* Whether path's format keeps linear floats (EXR); the others are 8-bit sRGB. */
+int image_is_float_format(const char *path);
+
+/* Starts loading OpenImageIO on a thread of its own, so that the vbcl binary, which loads
+ * it as a plugin (image_plugin.c) rather than at start-up, has it by the time it reads or
+ * writes an image. Only the vbcl binary has it; programs linked with image_io.cpp have
+ * OpenImageIO from the start. */
+void image_preload(void);
+
 /* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
  * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file
  * is written under a temporary name in the same directory and renamed into place, so an

@@ -1,0 +1,37 @@
+/* image_path.c — what image_io.h can say of a path without OpenImageIO: whether vbcl
+ * writes its format, and whether that format keeps linear floats. */
+#include "image_io.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <string.h>
+
+/* The extension of path's file name in lower case ("" without one), cut to fit ext. */
+static void image_ext(const char *path, char *ext, size_t n)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    size_t k = 0;
+    if (dot && !(slash && dot < slash))
+        for (const char *c = dot + 1; *c && k + 1 < n; c++)
+            ext[k++] = (char)tolower((unsigned char)*c);
+    ext[k] = '\0';
+}
+
+int image_check_path(const char *path, char *err, size_t errlen)
+{
+    char e[256];
+    image_ext(path, e, sizeof e);
+    if (!strcmp(e, "png") || !strcmp(e, "jpg") || !strcmp(e, "jpeg") || !strcmp(e, "tif") ||
+        !strcmp(e, "tiff") || !strcmp(e, "exr"))
+        return 0;
+    snprintf(err, errlen, "%s: unknown image format \"%s\" (expected .png, .jpg, .tif or .exr)",
+             path, e);
+    return -1;
+}
+
+int image_is_float_format(const char *path)
+{
+    char e[256];
+    image_ext(path, e, sizeof e);
+    return !strcmp(e, "exr");
+}
