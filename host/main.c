@@ -738,7 +738,7 @@ static int run(Dist *d, int argc, char **argv, double t0)
         rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
         if (rc)
             diag_print(prog, "%s", err);
-        else
+        else if (d->rank == 0 || first >= 0) /* the ranks that write images */
             image_preload();    /* OpenImageIO loads while the kernels are built and run */
         rc = dist_agree(d, rc); /* every rank has its devices, or all stop */
     }

@@ -44,15 +44,17 @@ static int plugin_file(void)
 #ifdef MFD_CLOEXEC
     fd = memfd_create("vbcl-image", MFD_CLOEXEC);
 #endif
+    const char *dir = getenv("TMPDIR");
+    if (!dir || !*dir) dir = "/tmp";
     if (fd < 0) {
-        const char *dir = getenv("TMPDIR");
         char path[4096];
-        snprintf(path, sizeof path, "%s/vbcl-image-XXXXXX", dir && *dir ? dir : "/tmp");
+        snprintf(path, sizeof path, "%s/vbcl-image-XXXXXX", dir);
         fd = mkstemp(path);
         if (fd >= 0) unlink(path);
     }
     if (fd < 0) {
-        snprintf(plugin.err, sizeof plugin.err, "cannot make a file for it: %s", strerror(errno));
+        snprintf(plugin.err, sizeof plugin.err, "cannot make a file for it in %s: %s", dir,
+                 strerror(errno));
         return -1;
     }
     const unsigned char *p = vbcl_image_plugin;
