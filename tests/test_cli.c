@@ -8,6 +8,7 @@
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <utime.h>
 
 #include <cJSON.h>
 
@@ -115,6 +116,74 @@ static void test_cli_image_plugin(void)
              tu_vbcl, scene, img);
     CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "libOpenImageIO") && file_exists(img),
           "a render loads OpenImageIO and writes %s", img);
+}
+
+/* The kernel cache keeps within VBCL_CACHE_MAX_MB: a cold build that stores its binary
+ * removes the least recently used binaries beyond it (never the new one, nor files that
+ * are not binaries); a warm run marks its binary used; a bad value is named and the
+ * default kept. */
+static void test_cli_cache_pruned(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    char dir[512], path[1024], cmd[4096], out[8192];
+    snprintf(dir, sizeof dir, "%s/prune-cache", tu_tmpdir());
+    mkdir(dir, 0755);
+    const char *names = "abcde"; /* a the oldest */
+    for (int i = 0; i < 5; i++) {
+        snprintf(path, sizeof path, "%s/%c.bin", dir, names[i]);
+        FILE *f = fopen(path, "wb");
+        for (int k = 0; f && k < 1 << 20; k++) fputc(0, f);
+        if (f) fclose(f);
+        struct utimbuf t = {946684800 + 86400 * i, 946684800 + 86400 * i}; /* 2000-01-0i */
+        utime(path, &t);
+    }
+    snprintf(path, sizeof path, "%s/notes.txt", dir);
+    FILE *f = fopen(path, "w");
+    if (f) fclose(f);
+    const char *scene = tu_write_file("prune.json", GOOD_SCENE);
+    snprintf(cmd, sizeof cmd,
+             "VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=3 timeout 300 %s %s -q --stats -o %s/p.png "
+             "--width 8 --height 8",
+             dir, tu_vbcl, scene, tu_tmpdir());
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "cold: built from source"),
+          "a cold build: %s", out);
+    uint64_t total = 0, fresh = 0;
+    int kept[5] = {0}, fresh_n = 0;
+    DIR *d = opendir(dir);
+    for (struct dirent *e; d && (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        if (len < 4 || strcmp(e->d_name + len - 4, ".bin")) continue;
+        struct stat st;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (stat(path, &st)) continue;
+        total += (uint64_t)st.st_size;
+        if (len == 5 && strchr(names, e->d_name[0])) {
+            kept[strchr(names, e->d_name[0]) - names] = 1;
+        } else {
+            fresh = (uint64_t)st.st_size;
+            fresh_n++;
+        }
+    }
+    if (d) closedir(d);
+    CHECK(fresh_n == 1 && fresh > 0, "the new binary is stored (%d)", fresh_n);
+    CHECK(total <= (fresh > (3u << 20) ? fresh : (3u << 20)),
+          "the binaries keep within 3 MB or the new one: %llu bytes", (unsigned long long)total);
+    for (int i = 1; i < 5; i++)
+        CHECK(!kept[i - 1] || kept[i], "the oldest go first: %c kept, %c not", names[i - 1],
+              names[i]);
+    CHECK(!kept[0], "the oldest dummy is gone");
+    snprintf(path, sizeof path, "%s/notes.txt", dir);
+    CHECK(file_exists(path), "a file that is not a binary stays");
+    snprintf(cmd, sizeof cmd,
+             "VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=x timeout 300 %s %s -q --stats -o %s/p.png "
+             "--width 8 --height 8",
+             dir, tu_vbcl, scene, tu_tmpdir());
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "warm: cached binary") &&
+              strstr(out, "VBCL_CACHE_MAX_MB=\"x\" is not a positive whole number"),
+          "a warm run names the bad limit: %s", out);
 }
 
 static void test_cli_list_devices(void)
@@ -753,6 +822,7 @@ void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
     RUN_TEST(test_cli_image_plugin);
+    RUN_TEST(test_cli_cache_pruned);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);

@@ -419,7 +419,9 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
     cl_program prog = NULL;
     *cached = 0;
     char dir[4096], path[4200] = "";
+    uint64_t cache_max = 0; /* checked on every run, so that a bad value is always named */
     if (cache_dir(NULL, dir, sizeof dir)) {
+        cache_max = cache_max_bytes();
         uint64_t h = CACHE_HASH_SEED;
         h = cache_hash(h, source);
         h = cache_hash(h, options);
@@ -436,6 +438,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
             free(bin);
             if (prog && rc == CL_SUCCESS && status == CL_SUCCESS &&
                 clBuildProgram(prog, 1, &d->device, options, NULL, NULL) == CL_SUCCESS) {
+                cache_touch(path); /* recently used: pruned last */
                 *cached = 1;
                 *ms = clu_now_ms() - t0;
                 return prog;
@@ -452,7 +455,10 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
         clu_fail(rc, "clBuildProgram", __FILE__, __LINE__);
         goto fail_program;
     }
-    if (path[0]) cache_store(prog, path);
+    if (path[0]) { /* then the least recently used binaries go, beyond the cache's size */
+        cache_store(prog, path);
+        cache_prune(dir, ".bin", cache_max, path);
+    }
     *ms = clu_now_ms() - t0;
     return prog;
 fail_program:

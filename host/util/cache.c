@@ -1,11 +1,13 @@
 /* cache.c — the cache directory and the hash that keys its files. */
 #include "cache.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <utime.h>
 
 const char *cache_dir(const char *sub, char *buf, size_t n)
 {
@@ -43,4 +45,79 @@ uint64_t cache_hash(uint64_t h, const char *s)
         h *= 1099511628211ull;
     }
     return h ^ 0xff;
+}
+
+uint64_t cache_max_bytes(void)
+{
+    const char *env = getenv("VBCL_CACHE_MAX_MB");
+    if (!env || !*env) return (uint64_t)CACHE_MAX_MB_DEFAULT << 20;
+    char *end;
+    errno = 0;
+    unsigned long long mb = strtoull(env, &end, 10);
+    if (errno || *end || mb == 0 || mb > (1ull << 40) || env[0] == '-') {
+        fprintf(stderr,
+                "vbcl: VBCL_CACHE_MAX_MB=\"%s\" is not a positive whole number of megabytes; "
+                "keeping the cache within %d MB\n",
+                env, CACHE_MAX_MB_DEFAULT);
+        return (uint64_t)CACHE_MAX_MB_DEFAULT << 20;
+    }
+    return (uint64_t)mb << 20;
+}
+
+void cache_touch(const char *path)
+{
+    utime(path, NULL); /* a cache file not marked is only pruned sooner */
+}
+
+typedef struct CacheFile {
+    char name[256];
+    uint64_t bytes;
+    struct timespec mtime;
+} CacheFile;
+
+static int cache_file_older(const void *a, const void *b)
+{
+    const struct timespec *x = &((const CacheFile *)a)->mtime, *y = &((const CacheFile *)b)->mtime;
+    if (x->tv_sec != y->tv_sec) return x->tv_sec < y->tv_sec ? -1 : 1;
+    return (x->tv_nsec > y->tv_nsec) - (x->tv_nsec < y->tv_nsec);
+}
+
+int cache_prune(const char *dir, const char *suffix, uint64_t max_bytes, const char *keep)
+{
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    CacheFile *files = NULL;
+    size_t n = 0, cap = 0, slen = strlen(suffix);
+    uint64_t total = 0;
+    char path[4096];
+    for (struct dirent *e; (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        if (len < slen || len >= sizeof files->name || strcmp(e->d_name + len - slen, suffix))
+            continue;
+        struct stat st;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (stat(path, &st) || !S_ISREG(st.st_mode)) continue;
+        if (n == cap) {
+            CacheFile *grown = realloc(files, sizeof *files * (cap = cap ? 2 * cap : 64));
+            if (!grown) break;
+            files = grown;
+        }
+        memcpy(files[n].name, e->d_name, len + 1);
+        files[n].bytes = (uint64_t)st.st_size;
+        files[n].mtime = st.st_mtim;
+        total += files[n++].bytes;
+    }
+    closedir(d);
+    int removed = 0;
+    if (files) qsort(files, n, sizeof *files, cache_file_older);
+    for (size_t i = 0; i < n && total > max_bytes; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i].name);
+        if (keep && strcmp(path, keep) == 0) continue;
+        if (remove(path) == 0) {
+            total -= files[i].bytes;
+            removed++;
+        }
+    }
+    free(files);
+    return removed;
 }

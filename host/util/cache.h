@@ -11,6 +11,21 @@
  * NULL when VBCL_CACHE_DIR is "off" or the directory cannot be made. */
 const char *cache_dir(const char *sub, char *buf, size_t n);
 
+/* The most bytes of compiled kernels the cache keeps: $VBCL_CACHE_MAX_MB megabytes
+ * (default CACHE_MAX_MB_DEFAULT; a value that is not a positive whole number is refused
+ * with a warning and the default kept). */
+#define CACHE_MAX_MB_DEFAULT 256
+uint64_t cache_max_bytes(void);
+
+/* Marks path as just used (its modification time now), so that cache_prune keeps it
+ * longer than the files not used since. */
+void cache_touch(const char *path);
+
+/* Keeps the files of dir whose names end in suffix within max_bytes in all, removing the
+ * least recently used first (oldest modification time), never the file `keep` (a path,
+ * or NULL). Returns how many it removed. */
+int cache_prune(const char *dir, const char *suffix, uint64_t max_bytes, const char *keep);
+
 /* FNV-1a over the bytes of s, continuing from h (start with CACHE_HASH_SEED). */
 #define CACHE_HASH_SEED 1469598103934665603ull
 uint64_t cache_hash(uint64_t h, const char *s);
