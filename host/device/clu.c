@@ -419,7 +419,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
     cl_program prog = NULL;
     *cached = 0;
     char dir[4096], path[4200] = "";
-    uint64_t cache_max = 0; /* checked on every run, so that a bad value is always named */
+    uint64_t cache_max = 0; /* read on every run, so that a bad value is always named */
     if (cache_dir(NULL, dir, sizeof dir)) {
         cache_max = cache_max_bytes();
         uint64_t h = CACHE_HASH_SEED;

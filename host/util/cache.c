@@ -3,6 +3,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,21 +48,32 @@ uint64_t cache_hash(uint64_t h, const char *s)
     return h ^ 0xff;
 }
 
-uint64_t cache_max_bytes(void)
+static pthread_once_t cache_max_once = PTHREAD_ONCE_INIT;
+static uint64_t cache_max;
+
+/* Reads VBCL_CACHE_MAX_MB into cache_max, once per run: a bad value is named once, however
+ * many devices build the program. */
+static void cache_max_read(void)
 {
+    cache_max = (uint64_t)CACHE_MAX_MB_DEFAULT << 20;
     const char *env = getenv("VBCL_CACHE_MAX_MB");
-    if (!env || !*env) return (uint64_t)CACHE_MAX_MB_DEFAULT << 20;
+    if (!env || !*env) return;
     char *end;
     errno = 0;
     unsigned long long mb = strtoull(env, &end, 10);
-    if (errno || *end || mb == 0 || mb > (1ull << 40) || env[0] == '-') {
+    if (errno || *end || mb == 0 || mb > (1ull << 40) || env[0] == '-')
         fprintf(stderr,
                 "vbcl: VBCL_CACHE_MAX_MB=\"%s\" is not a positive whole number of megabytes; "
                 "keeping the cache within %d MB\n",
                 env, CACHE_MAX_MB_DEFAULT);
-        return (uint64_t)CACHE_MAX_MB_DEFAULT << 20;
-    }
-    return (uint64_t)mb << 20;
+    else
+        cache_max = (uint64_t)mb << 20;
+}
+
+uint64_t cache_max_bytes(void)
+{
+    pthread_once(&cache_max_once, cache_max_read);
+    return cache_max;
 }
 
 void cache_touch(const char *path)

@@ -13,7 +13,7 @@ const char *cache_dir(const char *sub, char *buf, size_t n);
 
 /* The most bytes of compiled kernels the cache keeps: $VBCL_CACHE_MAX_MB megabytes
  * (default CACHE_MAX_MB_DEFAULT; a value that is not a positive whole number is refused
- * with a warning and the default kept). */
+ * with a warning, once per run, and the default kept). */
 #define CACHE_MAX_MB_DEFAULT 256
 uint64_t cache_max_bytes(void);
 

@@ -44,18 +44,18 @@ static int plugin_file(void)
 #ifdef MFD_CLOEXEC
     fd = memfd_create("vbcl-image", MFD_CLOEXEC);
 #endif
-    const char *dir = getenv("TMPDIR");
-    if (!dir || !*dir) dir = "/tmp";
     if (fd < 0) {
+        const char *dir = getenv("TMPDIR");
+        if (!dir || !*dir) dir = "/tmp";
         char path[4096];
         snprintf(path, sizeof path, "%s/vbcl-image-XXXXXX", dir);
         fd = mkstemp(path);
-        if (fd >= 0) unlink(path);
-    }
-    if (fd < 0) {
-        snprintf(plugin.err, sizeof plugin.err, "cannot make a file for it in %s: %s", dir,
-                 strerror(errno));
-        return -1;
+        if (fd < 0) {
+            snprintf(plugin.err, sizeof plugin.err, "cannot make a file for it in %s: %s", dir,
+                     strerror(errno));
+            return -1;
+        }
+        unlink(path);
     }
     const unsigned char *p = vbcl_image_plugin;
     while (p < vbcl_image_plugin_end) {
