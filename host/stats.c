@@ -104,6 +104,14 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
             st->aa_contrast_ms, st->aa_refine_ms, st->aa_reconstruct_ms);
 }
 
+/* How many times its first feelers a point in a penumbra traces (light_penumbra): the
+ * frame's factor where the feelers are a net of at least 2 x 2, else 1. */
+static unsigned penumbra_factor(const StatsFrame *fr)
+{
+    const VbFrame *f = &fr->r->frame_host;
+    return (f->flags & VBCL_FRAME_NET_FEELERS) && f->shadow_strata >= 2u ? f->penumbra_factor : 1u;
+}
+
 void stats_print(FILE *f, const StatsFrame *fr)
 {
     const Scene *s = fr->scene;
@@ -111,10 +119,15 @@ void stats_print(FILE *f, const StatsFrame *fr)
     unsigned long long rays = stats_rays_total(st);
     double kernel_ms = stats_kernel_ms(st);
     unsigned strata = fr->r->frame_host.shadow_strata;
+    char penumbra[160] = "";
+    if (penumbra_factor(fr) > 1u)
+        snprintf(penumbra, sizeof penumbra,
+                 ", %u times as many at %llu points in a penumbra (their first feelers disagree)",
+                 penumbra_factor(fr), st->shadow_penumbra);
     print_setup(f, fr);
     fprintf(
         f,
-        "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point%s; %llu "
+        "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point%s%s; %llu "
         "skipped: light behind the surface; %llu clear: not traced, their cone meets no "
         "object; %llu blocked: not traced, they pass through an opaque texture part's core; "
         "%llu unneeded: no BRDF response), total %llu\n",
@@ -122,7 +135,8 @@ void stats_print(FILE *f, const StatsFrame *fr)
         (st->features & VBCL_FEATURE_TRANSPARENCY) && s->shadow_by_weight
             ? ", fewer at ray-tree points weighing 1/4 or less"
             : "",
-        st->shadow_skipped, st->shadow_clear, st->shadow_blocked, st->shadow_unneeded, rays);
+        penumbra, st->shadow_skipped, st->shadow_clear, st->shadow_blocked, st->shadow_unneeded,
+        rays);
     if (st->features & VBCL_FEATURE_TRANSPARENCY) print_tree(f, s, st);
     if (st->features & (VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_TEXTURES))
         fprintf(f, "media       %llu crossings passed through (no change of material)\n",
@@ -265,6 +279,7 @@ static void json_rays(cJSON *root, const StatsFrame *fr, int *ok)
 #undef STATS_JSON_COUNTER
     num(rays, "total", (double)total, ok);
     num(rays, "shadow_feelers_per_light", strata * strata, ok);
+    num(rays, "penumbra_factor", penumbra_factor(fr), ok);
     cJSON *d = arr(rays, "by_depth", ok);
     for (int k = 0; d && k < VBCL_COUNT_DEPTH_BINS; k++)
         push(d, cJSON_CreateNumber((double)st->by_depth[k]), ok);

@@ -93,6 +93,7 @@ typedef struct ShadowCount {
     uint unneeded;
     uint clear;
     uint blocked;
+    uint penumbra; /* points (per light) whose first feelers disagreed and got more */
 } ShadowCount;
 
 /* What shading a point under one light needs besides the point itself: the BRDF's
@@ -395,24 +396,32 @@ VB_INLINE CapFeelers light_cap_feelers(int mode, uint strata, uint key)
     return cf;
 }
 
-/* Feeler (i, j) of the point's strata x strata, as (u1, u2) in the unit square.
+/* Feeler k = i * strata + j, (i, j) of the point's strata x strata, as (u1, u2) in the unit
+ * square (for the net, k from strata^2 on continues it: light_penumbra).
  * LIGHT_FEELERS_NET (strata a power of two: 16, the default, 4, 64, ...): point
- * i * strata + j of the (0, 2)-sequence, Owen-scrambled by the key, a (0, 2m, 2)-net with
+ * k of the (0, 2)-sequence, Owen-scrambled by the key, a (0, 2m, 2)-net with
  * one point in every elementary rectangle of every shape, so a shadow edge crossing the
  * cap at any angle is sampled more evenly than by jittered squares. _JITTERED: a random
  * point of square stratum (i, j); _FIXED: its centre. */
-VB_INLINE float2 light_cap_uv(const CapFeelers *cf, uint i, uint j)
+VB_INLINE float2 light_cap_uv_at(const CapFeelers *cf, uint k)
 {
     uint strata = cf->strata;
     if (cf->mode == LIGHT_FEELERS_NET) {
-        uint2 q = vb_sobol2_reversed(i * strata + j);
+        uint2 q = vb_sobol2_reversed(k);
         return (float2)(vb_unit_float(vb_owen_scramble_reversed(q.x, cf->seed_u)),
                         vb_unit_float(vb_owen_scramble_reversed(q.y, cf->seed_v)));
     }
+    uint i = k / strata, j = k - i * strata;
     int jitter = cf->mode == LIGHT_FEELERS_JITTERED;
-    uint h = vb_hash(cf->key ^ vb_hash(i * strata + j + 0x9e3779b9u));
+    uint h = vb_hash(cf->key ^ vb_hash(k + 0x9e3779b9u));
     return (float2)(((float)i + (jitter ? vb_unit_float(h) : 0.5f)) / (float)strata,
                     ((float)j + (jitter ? vb_unit_float(vb_hash(h)) : 0.5f)) / (float)strata);
+}
+
+/* light_cap_uv_at of feeler (i, j). */
+VB_INLINE float2 light_cap_uv(const CapFeelers *cf, uint i, uint j)
+{
+    return light_cap_uv_at(cf, i * cf->strata + j);
 }
 
 /* The direction at (u1, u2) of the unit square on the cap of half-angle theta_max around
@@ -455,6 +464,18 @@ VB_INLINE float3 light_cap_closed(const LightShading *ls, const ShadePoint *sp, 
 }
 
 #ifdef VBCL_HAS_AREA_LIGHTS
+/* Whether a point whose first feelers (cf) let through between lo and hi of the light (the
+ * largest channel) traces penumbra_factor times as many: they disagree by more than
+ * LIGHT_PENUMBRA_SPREAD, so the cap is part hidden, and there are at least 4 of them in a
+ * scrambled net, whose continuation keeps every elementary rectangle filled. Where the first
+ * ones agree the point keeps them: a cap all visible or all hidden needs no more. */
+#define LIGHT_PENUMBRA_SPREAD 0.05f
+VB_INLINE int light_penumbra(__constant const VbFrame *f, const CapFeelers *cf, float lo, float hi)
+{
+    return f->penumbra_factor > 1u && cf->mode == LIGHT_FEELERS_NET && cf->strata >= 2u &&
+           hi - lo > LIGHT_PENUMBRA_SPREAD;
+}
+
 /* The direction of feeler (i, j) on the cap (light_cap_at at light_cap_uv). */
 VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float one_minus_cos,
                                      float3 tx, float3 ty, float3 wc)
@@ -464,7 +485,9 @@ VB_INLINE float3 light_cap_direction(const CapFeelers *cf, uint i, uint j, float
 
 /* Reflected radiance from a spherical light of radius r > 0 that the point sees from
  * outside: the visible cap sampled at strata^2 stratified directions, each direction's
- * feeler traced to the sphere, L * Omega * mean(V * f * cos). strata: the point's
+ * feeler traced to the sphere, L * Omega * mean(V * f * cos); where those disagree (a
+ * penumbra: light_penumbra) the mean is over penumbra_factor times as many, the net's next
+ * points. strata: the point's
  * (light_node_strata); where the specular lobe can reach the cap the frame's own instead,
  * since a highlight's feelers differ far more than a diffuse term's (their spread is what
  * light_node_strata takes to be alike at every point). */
@@ -502,9 +525,11 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
 #ifdef VBCL_HAS_SPECULAR
     float3 sum_s = (float3)(0.0f);
 #endif
-    for (uint i = 0; i < strata; i++) {
-        for (uint j = 0; j < strata; j++) {
-            float3 w = light_cap_direction(&cf, i, j, one_minus_cos, tx, ty, wc);
+    uint n = strata * strata, total = n;
+    float vis_lo = 2.0f, vis_hi = -1.0f;
+    for (uint k = 0;;) {
+        for (; k < total; k++) {
+            float3 w = light_cap_at(light_cap_uv_at(&cf, k), one_minus_cos, tx, ty, wc);
             float cos_n = dot(sp->ns, w);
             if (cos_n <= 0.0f || dot(sp->ng, w) <= 0.0f) {
                 sc->skipped++;
@@ -518,17 +543,23 @@ VB_INLINE float3 light_reflect_area(const DevScene *scn, const ShadePoint *sp,
             float t_light = light_sphere_near(ls, w, r);
             float3 vis =
                 light_feeler_decided(scn, sp, &os, ls->origin, w, t_light, tex_free, tc, sc);
-            if (vb_max3(vis) <= 0.0f) continue;
+            float v = vb_max3(vis);
+            vis_lo = fmin(vis_lo, v);
+            vis_hi = fmax(vis_hi, v);
+            if (v <= 0.0f) continue;
             open += fmin(vis.x, fmin(vis.y, vis.z)) >= 1.0f;
             sum_cos += vis * cos_n;
 #ifdef VBCL_HAS_SPECULAR
             if (ls->specular && nh > ls->nh_min) sum_s += vis * (powr(nh, ls->exponent) * cos_n);
 #endif
         }
+        if (total != n || !light_penumbra(scn->f, &cf, vis_lo, vis_hi)) break;
+        total = n * scn->f->penumbra_factor; /* the net's next points: still a (0, 2)-net */
+        sc->penumbra++;
     }
-    if (closed && open == strata * strata) /* as if the cone test had found nothing */
+    if (closed && open == total) /* as if the cone test had found nothing */
         return radiance * light_cap_closed(ls, sp, wc, sin_max);
-    float scale = omega / (float)(strata * strata);
+    float scale = omega / (float)total;
     float3 sum_d = ls->kd * (sum_cos * scale);
 #ifdef VBCL_HAS_SPECULAR
     sum_d += ls->ks * (ls->spec_norm * sum_s * scale);

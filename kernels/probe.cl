@@ -73,7 +73,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.front = 0;
     sp.band = (int)pnormals[4 * i + 3] - 1;
     TraceCount tc = {0, 0};
-    ShadowCount sc2 = {0, 0, 0, 0, 0};
+    ShadowCount sc2 = {0, 0, 0, 0, 0, 0};
     float3 col = light_shade_local(&sc, &sp, f->shadow_strata, &tc, &sc2);
     vstore4((float4)(col, (float)sc2.traced), i, radiance);
 }
@@ -376,7 +376,7 @@ __kernel void probe_sole_exit(SCENE_KERNEL_ARGS __global const float *cases, int
                                             : (os.n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
         if (need == OBJECT_SET_BLOCKED || (need == OBJECT_SET_ALONE && os.n == 0)) continue;
         TraceCount tc = {0, 0};
-        ShadowCount shc = {0, 0, 0, 0, 0};
+        ShadowCount shc = {0, 0, 0, 0, 0, 0};
         float3 fast = light_feeler_decided(&sc, &sp, &os, ls.origin, w, t_light,
                                            sp.medium.tex_counts == 0u, &tc, &shc);
         float3 ref = probe_transmittance_plain(&sc, need == OBJECT_SET_GRID ? &grid : &os,
@@ -582,7 +582,7 @@ __kernel void probe_shade_feelers(SCENE_KERNEL_ARGS __global const VbRay *rays,
     ShadePoint sp;
     float3 col = (float3)(0.0f);
     TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0, 0, 0, 0};
+    ShadowCount shc = {0, 0, 0, 0, 0, 0};
     if (probe_primary_point(&sc, rays, hits, media, (int)points[j], &sp))
         col = light_shade_local(&sc, &sp, f->shadow_strata, &tc, &shc);
     /* decided: traced, or clear or blocked by the cone test */

@@ -146,6 +146,7 @@ VB_INLINE void shade_flush_counts(__global uint *counters, const TraceCount *tc,
     atomic_add(&counters[VBCL_COUNT_SHADOW_UNNEEDED], shc->unneeded);
     atomic_add(&counters[VBCL_COUNT_SHADOW_CLEAR], shc->clear);
     atomic_add(&counters[VBCL_COUNT_SHADOW_BLOCKED], shc->blocked);
+    atomic_add(&counters[VBCL_COUNT_SHADOW_PENUMBRA], shc->penumbra);
     atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc->steps);
     atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc->tests);
 }
@@ -182,7 +183,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 #endif
         ShadePoint sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, material);
         TraceCount tc = {0, 0};
-        ShadowCount shc = {0, 0, 0, 0, 0};
+        ShadowCount shc = {0, 0, 0, 0, 0, 0};
         col = weight * light_shade_local(&sc, &sp, f->shadow_strata, &tc, &shc);
         shade_flush_counts(counters, &tc, &shc);
     }
@@ -277,7 +278,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     TreeCount cnt = {0};
     cnt.prune_budget = f->min_weight;
     TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0, 0, 0, 0};
+    ShadowCount shc = {0, 0, 0, 0, 0, 0};
     tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
                -1, rec);
     float3 acc = tree_run(&sc, stack, n, &cnt, &tc, &shc, rec);
@@ -304,7 +305,7 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     TreeCount cnt = {0};
     cnt.prune_budget = rec->budget;
     TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0, 0, 0, 0};
+    ShadowCount shc = {0, 0, 0, 0, 0, 0};
     float3 acc = (float3)(0.0f);
     for (int k = 0; k < count; k++) {
         VbSplit s = rec->s[k];

@@ -73,13 +73,14 @@
     X(BAND_RAYS,       14, band_rays,       ray_tree, "band_rays")        /* one-band rays */     \
     X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */  \
     X(SHADOW_CLEAR,    16, shadow_clear,    rays,     "shadow_clear")     /* cone meets nothing */ \
-    X(SHADOW_BLOCKED,  17, shadow_blocked,  rays,     "shadow_blocked")   /* through a solid core */
+    X(SHADOW_BLOCKED,  17, shadow_blocked,  rays,     "shadow_blocked")   /* solid core */        \
+    X(SHADOW_PENUMBRA, 18, shadow_penumbra, rays,     "shadow_penumbra")  /* more in penumbra */
 /* clang-format on */
 #define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
 enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
-#define VBCL_COUNT_DEPTH0     18 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH0     19 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS 16
-#define VBCL_COUNTERS         34
+#define VBCL_COUNTERS         35
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {
@@ -263,16 +264,18 @@ typedef struct VbFrame {
     unsigned int ntris;
     unsigned int shadow_strata; /* feelers per light per point: shadow_strata^2 */
     unsigned int seed;
-    VbMedium camera_medium;    /* where the camera is, computed on the host */
-    unsigned int air_material; /* index of the material outside every host */
-    float min_weight;          /* branches whose weight is below this in every channel stop */
-    int max_depth;             /* deepest ray-tree level traced (primary rays: 0) */
-    int bands;                 /* wavelength bands of a dispersive split */
-    unsigned int band_weights; /* first float of the bands' rgb weights (4 floats each) in the
-                                * side data (texels) */
-    unsigned int flags;        /* VBCL_FRAME_* */
-    unsigned int nobjects;     /* objects (VbObject), for the shadow cone test */
-    unsigned int pad[3];
+    VbMedium camera_medium;       /* where the camera is, computed on the host */
+    unsigned int air_material;    /* index of the material outside every host */
+    float min_weight;             /* branches whose weight is below this in every channel stop */
+    int max_depth;                /* deepest ray-tree level traced (primary rays: 0) */
+    int bands;                    /* wavelength bands of a dispersive split */
+    unsigned int band_weights;    /* first float of the bands' rgb weights (4 floats each) in the
+                                   * side data (texels) */
+    unsigned int flags;           /* VBCL_FRAME_* */
+    unsigned int nobjects;        /* objects (VbObject), for the shadow cone test */
+    unsigned int penumbra_factor; /* a point whose first feelers toward a light disagree traces
+                                   * this many times as many (1: never; light_reflect_area) */
+    unsigned int pad[2];
 } VbFrame;
 
 /* VbFrame.flags */
@@ -331,7 +334,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -374,6 +377,7 @@ VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
 VBCL_STATIC_ASSERT(sizeof(VbFrame) == 256, frame_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, flags) == 236, frame_flags);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, nobjects) == 240, frame_nobjects);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, penumbra_factor) == 244, frame_penumbra_factor);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, max_depth) == 224, frame_max_depth);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, camera_medium) == 208, frame_camera_medium);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, min_weight) == 220, frame_min_weight);

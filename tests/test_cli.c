@@ -578,7 +578,11 @@ static void test_cli_bad_input_classes(void)
         NULL, "segments"); /* absurd count */
     expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
                " \"render\": {\"shadow_by_weight\": 1}}",
-               NULL, "render.shadow_by_weight");         /* a number for a boolean */
+               NULL, "render.shadow_by_weight"); /* a number for a boolean */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
+               " \"render\": {\"penumbra_feelers\": 3}}",
+               NULL, "render.penumbra_feelers"); /* not a power of two */
+    expect_bad(GOOD_SCENE, "--penumbra-feelers 6", "--penumbra-feelers 6");
     expect_bad(GOOD_SCENE, "--grid 0", "--grid");        /* bad option */
     expect_bad(GOOD_SCENE, "--grid 4:65", "SUB 1..64");  /* sub-grid too fine */
     expect_bad(GOOD_SCENE, "--width 100000", "--width"); /* absurd image size */

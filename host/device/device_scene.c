@@ -703,6 +703,7 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
         f->flags |= VBCL_FRAME_CONE_TEST;
     if (s->shadow_by_weight) f->flags |= VBCL_FRAME_WEIGHTED_FEELERS;
     f->nobjects = (unsigned)s->nobjects;
+    f->penumbra_factor = (unsigned)s->penumbra_feelers;
     scene_medium_at(s, s->eye, &f->camera_medium);
     f->air_material = (unsigned)s->nmaterials;
     f->min_weight = s->min_weight;

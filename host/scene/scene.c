@@ -256,6 +256,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "subgrid_density",
                                        "shadow_cone_test",
                                        "shadow_by_weight",
+                                       "penumbra_feelers",
                                        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
     s->max_depth = 6;
@@ -276,6 +277,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->shadow_jitter = 1;
     s->shadow_cone_test = 1;
     s->shadow_by_weight = 1;
+    s->penumbra_feelers = SCENE_PENUMBRA_FEELERS;
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -287,8 +289,13 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         json_get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
         json_get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
         json_get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight) ||
+        json_get_int(c, j, "render", "penumbra_feelers", 1, SCENE_PENUMBRA_FEELERS_MAX,
+                     SCENE_PENUMBRA_FEELERS, 0, &s->penumbra_feelers) ||
         get_aa(c, j, s) || get_bands(c, j, s))
         return -1;
+    if (!scene_penumbra_feelers_ok(s->penumbra_feelers))
+        return scene_fail(c, "render.penumbra_feelers", "expected 1, 2, 4, 8 or 16, got %d",
+                          s->penumbra_feelers);
     s->seed = (unsigned)seed;
     if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
         get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||

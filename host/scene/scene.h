@@ -52,6 +52,14 @@ enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
 #define SCENE_AA_FLOOR 0.0f
 /* render.aa_level_gain's default: the threshold grows by this factor per level. */
 #define SCENE_AA_LEVEL_GAIN 2.0f
+/* render.penumbra_feelers's default and largest value: a power of two, so that the extra
+ * feelers continue the first ones' scrambled net into a larger net (light_penumbra). */
+#define SCENE_PENUMBRA_FEELERS     4
+#define SCENE_PENUMBRA_FEELERS_MAX 16
+static inline int scene_penumbra_feelers_ok(int k)
+{
+    return k >= 1 && k <= SCENE_PENUMBRA_FEELERS_MAX && (k & (k - 1)) == 0;
+}
 
 typedef struct Scene {
     char *path; /* the scene file as given */
@@ -77,6 +85,8 @@ typedef struct Scene {
     int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_objects) */
     int shadow_by_weight; /* render.shadow_by_weight: feelers of ray-tree nodes by their weight
                            * (light_node_strata); 0: all shadow_samples at every node */
+    int penumbra_feelers; /* render.penumbra_feelers: a point whose first feelers toward a light
+                           * disagree traces this many times as many (light_penumbra); 1: never */
     int fresnel;          /* SCENE_FRESNEL_* */
     float min_weight;     /* ray-tree pruning threshold */
     float aa_threshold;   /* adaptive anti-aliasing contrast threshold; 0: off */

@@ -817,6 +817,9 @@ static int bench_open(Bench *b)
     if (o->height) b->s.height = o->height;
     if (o->shadow_samples) b->s.shadow_samples = o->shadow_samples;
     if (o->no_cone_test) b->s.shadow_cone_test = 0;
+    /* the first feelers only: probe_feeler_rays exports them without tracing, so it cannot
+     * know which points a penumbra gives more (light_penumbra) */
+    b->s.penumbra_feelers = 1;
     if (o->subgrid_density > 0.0f) b->s.subgrid_density = o->subgrid_density;
     if (o->grid && scene_parse_grid(o->grid, b->s.grid_res)) {
         fprintf(stderr, "vbcl-bench-rays: --grid %s: expected auto, N or NX,NY,NZ\n", o->grid);
