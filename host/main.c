@@ -303,7 +303,8 @@ static int parse_args(int argc, char **argv, Options *o)
     }
     if (!o->scene && !o->list_devices) return usage_error("%s", "no scene file given");
     if (o->penumbra_feelers && !scene_penumbra_feelers_ok(o->penumbra_feelers))
-        return usage_error("--penumbra-feelers %d: expected 1, 2, 4, 8 or 16", o->penumbra_feelers);
+        return usage_error("--penumbra-feelers %d: expected " SCENE_PENUMBRA_FEELERS_SET,
+                           o->penumbra_feelers);
     return -1;
 }
 

@@ -294,8 +294,8 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_aa(c, j, s) || get_bands(c, j, s))
         return -1;
     if (!scene_penumbra_feelers_ok(s->penumbra_feelers))
-        return scene_fail(c, "render.penumbra_feelers", "expected 1, 2, 4, 8 or 16, got %d",
-                          s->penumbra_feelers);
+        return scene_fail(c, "render.penumbra_feelers",
+                          "expected " SCENE_PENUMBRA_FEELERS_SET ", got %d", s->penumbra_feelers);
     s->seed = (unsigned)seed;
     if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
         get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||

@@ -56,6 +56,7 @@ enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
  * feelers continue the first ones' scrambled net into a larger net (light_penumbra). */
 #define SCENE_PENUMBRA_FEELERS     4
 #define SCENE_PENUMBRA_FEELERS_MAX 16
+#define SCENE_PENUMBRA_FEELERS_SET "1, 2, 4, 8 or 16" /* the values that are ok */
 static inline int scene_penumbra_feelers_ok(int k)
 {
     return k >= 1 && k <= SCENE_PENUMBRA_FEELERS_MAX && (k & (k - 1)) == 0;
