@@ -56,7 +56,8 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
                             int s, int lv, float3 a)
 {
     int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE;
-    float threshold = aa->threshold * pown(aa->level_gain, lv);
+    float threshold = aa->threshold; /* x level_gain^lv (pown costs an exp and a log here) */
+    for (int l = 0; l < lv; l++) threshold *= aa->level_gain;
     for (int side = 0; side < 4; side++) {
         int row = side < 2; /* sides 0, 1: the rows above and below, corners included */
         int fixed = row ? (side == 0 ? Y0 - 1 : Y0 + s) : (side == 2 ? X0 - 1 : X0 + s);
