@@ -479,7 +479,7 @@ static int load_frame(const Options *o, const char *text, int frame, Scene *s)
  * max). Returns 0, or an exit status after a message. */
 static int render_image(const Options *o, const Scene *s, VbDevice *devs, int ndev, Dist *d,
                         Frame *fr, float *rgba, RenderStats *st, DeviceWork *work, int *nwork,
-                        int max)
+                        int max, double *image_wait_ms)
 {
     char err[1024] = "";
     long npix = (long)s->width * s->height;
@@ -498,6 +498,9 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
     }
     if (!rc) {
         int progress = !o->quiet && isatty(STDERR_FILENO);
+        double tl = clu_now_ms();
+        image_preload_wait(); /* the kernels' first launches would wait for it inside */
+        *image_wait_ms = clu_now_ms() - tl;
         rc = frame_render(fr, s, rgba, st, progress, err, sizeof err) ? 1 : 0;
     }
     if (shared) dist_tiles_end(d);
@@ -536,7 +539,8 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
         dist_abort(d, 1); /* with other ranks: they wait for tiles */
         goto done;
     }
-    rc = render_image(o, &s, devs, ndev, d, &fr, rgba, &st, work, &nwork, max);
+    double image_wait_ms = 0.0;
+    rc = render_image(o, &s, devs, ndev, d, &fr, rgba, &st, work, &nwork, max, &image_wait_ms);
     if (rc) goto done;
     double tw = clu_now_ms();
     if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err) ||
@@ -548,8 +552,9 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
         rc = 1;
         goto done;
     }
-    StatsFrame sf = {&s,   &devs[0], &fr.r, &st, frame, clu_now_ms() - tw, clu_now_ms() - t0,
-                     work, nwork};
+    StatsFrame sf = {
+        &s,   &devs[0], &fr.r, &st, frame, image_wait_ms, clu_now_ms() - tw, clu_now_ms() - t0,
+        work, nwork};
     rc = report_frame(o, &sf, out, json);
 done:
     frame_release(&fr);

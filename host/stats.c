@@ -147,9 +147,10 @@ void stats_print(FILE *f, const StatsFrame *fr)
     fprintf(f,
             "time        upload %.1f ms | camera %.1f ms, intersect %.1f ms, shading+shadows %.1f "
             "ms, ray trees %.1f ms, dispersive subtrees %.1f ms, readback %.1f ms (device) | "
-            "render %.1f ms, write %.1f ms, total %.1f ms (wall)\n",
+            "image library %.1f ms, render %.1f ms, write %.1f ms, total %.1f ms (wall)\n",
             st->upload_ms, st->camera_ms, st->intersect_ms, st->shading_ms, st->tree_ms,
-            st->dispersion_ms, st->readback_ms, st->render_ms, fr->write_ms, fr->total_ms);
+            st->dispersion_ms, st->readback_ms, fr->image_wait_ms, st->render_ms, fr->write_ms,
+            fr->total_ms);
     fprintf(f, "throughput  %.2f Mrays/s over kernel time (%d tiles of up to %d pixels)\n",
             kernel_ms > 0 ? (double)rays / (kernel_ms * 1e3) : 0.0, st->tiles, st->tile_pixels);
     for (int i = 0; i < fr->nwork; i++) {
@@ -331,6 +332,7 @@ static void json_times(cJSON *root, const StatsFrame *fr, int *ok)
     num(o, "dispersive_subtrees", st->dispersion_ms, ok);
     num(o, "readback", st->readback_ms, ok);
     num(o, "kernels", kernel_ms, ok);
+    num(o, "image_wait", fr->image_wait_ms, ok);
     num(o, "render", st->render_ms, ok);
     num(o, "write", fr->write_ms, ok);
     num(o, "total", fr->total_ms, ok);

@@ -19,6 +19,7 @@ typedef struct StatsFrame {
     const Renderer *r;
     const RenderStats *st;
     int frame;              /* frame of an animation, or -1 */
+    double image_wait_ms;   /* wall time the render waited for OpenImageIO to load */
     double write_ms;        /* wall time of writing the image (and --aa-map) */
     double total_ms;        /* wall time of the frame's work, from loading the scene on */
     const DeviceWork *work; /* what each device did (tiles.h), nwork of them */

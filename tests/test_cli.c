@@ -796,6 +796,19 @@ static void test_cli_stats_json(void)
     CHECK(json_num(doc, "samples", "per_pixel_max", NULL) == spp_max,
           "samples.per_pixel_max %g, text %u", json_num(doc, "samples", "per_pixel_max", NULL),
           spp_max);
+    /* the wall times: the wait for OpenImageIO, the render and the write are parts of the
+     * total that do not overlap; the text prints the wait as "image library" */
+    double wait = json_num(doc, "time_ms", "image_wait", NULL);
+    double render = json_num(doc, "time_ms", "render", NULL);
+    double write = json_num(doc, "time_ms", "write", NULL);
+    double whole = json_num(doc, "time_ms", "total", NULL);
+    CHECK(wait >= 0 && render >= 0 && write >= 0 && wait + render + write <= whole + 0.5,
+          "time_ms: image_wait %g + render %g + write %g within total %g", wait, render, write,
+          whole);
+    double wait_text = -1;
+    if ((l = strstr(out, "| image library "))) sscanf(l, "| image library %lf ms", &wait_text);
+    CHECK(fabs(wait_text - wait) <= 0.051, "the text's image library %g ms, time_ms.image_wait %g",
+          wait_text, wait);
     cJSON_Delete(doc);
     /* -q and no --stats: nothing printed, the file still written */
     remove(json);

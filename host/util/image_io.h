@@ -21,6 +21,12 @@ int image_is_float_format(const char *path);
  * OpenImageIO from the start. */
 void image_preload(void);
 
+/* Waits until the load image_preload started has ended (at once if none is under way):
+ * vbcl renders only then, since PoCL's first launch of each kernel loads the kernel's code
+ * through the same dynamic loader and would wait for OpenImageIO's 260 libraries anyway,
+ * inside the render's timing. */
+void image_preload_wait(void);
+
 /* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
  * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file
  * is written under a temporary name in the same directory and renamed into place, so an

@@ -117,6 +117,13 @@ void image_preload(void)
     pthread_mutex_unlock(&plugin_lock);
 }
 
+void image_preload_wait(void)
+{
+    pthread_mutex_lock(&plugin_lock);
+    while (plugin.state == PLUGIN_LOADING) pthread_cond_wait(&plugin_loaded, &plugin_lock);
+    pthread_mutex_unlock(&plugin_lock);
+}
+
 /* Waits for the plugin (loading it here if image_preload did not start it); 0 when it
  * is there, else -1 with a message naming path in err. */
 static int plugin_ready(const char *path, char *err, size_t errlen)
