@@ -149,10 +149,17 @@ VB_INLINE int object_segment_through_core(__global const VbObject *ob, float3 or
 
 /* The stretch [s0, s1] of the segment from org along the unit dir to distance t that lies
  * inside the convex host ob (VBCL_OBJECT_HULL), each plane of its triangles clipping it,
- * widened by margin m at both ends; s0 > s1 where it misses the host. */
+ * widened by margin m at both ends; s0 > s1 where it misses the host. A host of more than
+ * VB_HULL_PLANES triangles gives the stretch in its bounding sphere instead, which holds
+ * the one inside it. */
+#define VB_HULL_PLANES 64
 VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject *ob, float3 org,
                                      float3 dir, float t, float m)
 {
+    if (ob->ntris > VB_HULL_PLANES) {
+        float2 c = object_chord(ob, org, dir, t);
+        return (float2)(fmax(c.x, 0.0f) - m, fmin(c.y, t) + m);
+    }
     float s0 = 0.0f, s1 = t;
     for (uint k = ob->first_tri; k < ob->first_tri + ob->ntris; k++) {
         float3 v0 = tri_vertex(sc->tris, (int)k, 0).xyz;

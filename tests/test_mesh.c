@@ -148,6 +148,66 @@ static void test_sphere_closed_outward(void)
     mesh_free(&m);
 }
 
+/* The largest distance by which a vertex of m lies in front of a triangle's plane. */
+static double worst_vertex_in_front(const Mesh *m)
+{
+    double worst = -INFINITY;
+    for (uint32_t t = 0; t < m->ntris; t++) {
+        vec3 a = m->verts[m->tris[3 * t]], b = m->verts[m->tris[3 * t + 1]],
+             c = m->verts[m->tris[3 * t + 2]];
+        vec3 n = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        for (uint32_t v = 0; v < m->nverts; v++)
+            worst = fmax(worst, v3_dot(n, v3_sub(m->verts[v], a)));
+    }
+    return worst;
+}
+
+/* mesh_part_convex against the vertex-by-plane definition: tessellated spheres are convex
+ * (up to level 3 also by the definition); a level-3 sphere with one vertex pushed in or
+ * pulled out by 1% of the radius (a dent; a spike, whose foot is concave) is not, and the
+ * definition agrees; nor an open sphere, two disjoint ones in one range (each alone is),
+ * or a box, whose faces' two triangles are coplanar (flat edges are refused). */
+static void test_part_convex(void)
+{
+    for (int level = 0; level <= 6; level++) {
+        Mesh m;
+        mesh_init(&m);
+        CHECK(shape_sphere(&m, level) == 0, "level %d", level);
+        CHECK(mesh_part_convex(&m, 0, m.ntris, 1e-9) == 1, "sphere level %d: not convex", level);
+        if (level <= 3) {
+            double w = worst_vertex_in_front(&m);
+            CHECK(w < 1e-6, "level %d: a vertex %g in front of a plane", level, w);
+        }
+        if (level == 3) {
+            vec3 keep = m.verts[7];
+            for (int k = 0; k < 2; k++) {
+                m.verts[7] = v3_scale(keep, k ? 1.01f : 0.99f);
+                double w = worst_vertex_in_front(&m);
+                CHECK(mesh_part_convex(&m, 0, m.ntris, 1e-9) == 0 && w > 1e-4,
+                      "%s: convex by edges, %g in front", k ? "a spike" : "a dent", w);
+            }
+            m.verts[7] = keep;
+            CHECK(mesh_part_convex(&m, 1, m.ntris - 1, 1e-9) == 0, "an open sphere passes");
+            uint32_t n = m.ntris;
+            Mesh two;
+            mesh_init(&two);
+            CHECK(shape_sphere(&two, 3) == 0, "second sphere");
+            mat4 xf = mat4_translate(v3(3, 0, 0));
+            mesh_transform(&two, &xf);
+            CHECK(mesh_append(&m, &two) == 0, "append");
+            CHECK(mesh_part_convex(&m, 0, m.ntris, 1e-9) == 0, "two spheres pass as one");
+            CHECK(mesh_part_convex(&m, n, n, 1e-9) == 1, "the second sphere alone");
+            mesh_free(&two);
+        }
+        mesh_free(&m);
+    }
+    Mesh box;
+    mesh_init(&box);
+    CHECK(shape_box(&box, v3(1, 2, 3)) == 0, "box");
+    CHECK(mesh_part_convex(&box, 0, box.ntris, 1e-9) == 0, "a box's flat edges pass");
+    mesh_free(&box);
+}
+
 static void test_box_exact(void)
 {
     char err[256];
@@ -775,6 +835,7 @@ static void cleanup_tmpdir(void)
 void suite_mesh(void)
 {
     RUN_TEST(test_sphere_closed_outward);
+    RUN_TEST(test_part_convex);
     RUN_TEST(test_box_exact);
     RUN_TEST(test_prism_both_windings);
     RUN_TEST(test_quad_open);

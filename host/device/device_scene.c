@@ -391,6 +391,19 @@ static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex
     return convex;
 }
 
+/* Whether a host's own triangles first .. first + n - 1 of m bound a convex volume
+ * (VBCL_OBJECT_HULL), for an object of size `size`: every vertex behind every plane within
+ * 1e-6 of it (object_convex) where that takes at most 2^24 tests (2364 triangles); beyond,
+ * strictly convex at every edge of one closed surface of genus 0 (mesh_part_convex, tol
+ * 1e-9 of the size: a tessellated sphere of 81,920 triangles is convex by 4e-5 of it). */
+static int hull_convex(const Mesh *m, uint32_t first, uint32_t n, double size)
+{
+    const uint64_t budget = 1u << 24;
+    if (3 * (uint64_t)n * (uint64_t)n <= budget)
+        return object_convex(m, first, n, 0, 0, 1e-6 * size, budget);
+    return mesh_part_convex(m, first, n, 1e-9 * size);
+}
+
 /* Where triangles first .. first + n - 1 of m and the texture's tex_first .. tex_first +
  * tex_n - 1 lie, for the shadow cone test (light.cl, light_cone_objects): a sphere and a box
  * holding them all, and where every vertex lies within 1e-6 of the size of one plane (a
@@ -621,8 +634,7 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         if (nruns <= 0) continue;
         double mag = 0.0;
         for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(g->lo[a]), fabs(g->hi[a])));
-        if (o->is_host && object_convex(&s->mesh, o->first_tri, o->ntris, 0, 0,
-                                        1e-6 * (mag + g->bound[3]), 1u << 24))
+        if (o->is_host && hull_convex(&s->mesh, o->first_tri, o->ntris, mag + g->bound[3]))
             g->flags |= VBCL_OBJECT_HULL;
         VbObject *grown = realloc(objs, sizeof *objs * (n + (size_t)nruns));
         if (!grown) goto fail;

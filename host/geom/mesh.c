@@ -1,6 +1,7 @@
 /* mesh.c — indexed triangle mesh storage, transforms, bounds and the closed-surface check. */
 #include "mesh.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,6 +194,12 @@ typedef struct Edge {
     uint32_t tri_dir;
 } Edge;
 
+static int cmp_u32_mesh(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
 static int compare_edges(const void *pa, const void *pb)
 {
     const Edge *a = pa, *b = pb;
@@ -278,6 +285,90 @@ static int check_edges(const Mesh *m, const Edge *edges, size_t ne, char *err, s
         return -1;
     }
     return 0;
+}
+
+/* Union-find root of i, halving the path. */
+static uint32_t uf_root(uint32_t *parent, uint32_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Signed distance (times the normal's length) of vertex v from the plane of triangle t. */
+static double plane_side(const Mesh *m, uint32_t t, uint32_t v, double *len)
+{
+    const uint32_t *c = m->tris + 3 * (size_t)t;
+    vec3 a = m->verts[c[0]], b = m->verts[c[1]], d = m->verts[c[2]], p = m->verts[v];
+    double e1[3] = {(double)b.x - a.x, (double)b.y - a.y, (double)b.z - a.z};
+    double e2[3] = {(double)d.x - a.x, (double)d.y - a.y, (double)d.z - a.z};
+    double nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2],
+           nz = e1[0] * e2[1] - e1[1] * e2[0];
+    *len = sqrt(nx * nx + ny * ny + nz * nz);
+    return nx * ((double)p.x - a.x) + ny * ((double)p.y - a.y) + nz * ((double)p.z - a.z);
+}
+
+/* The corner of triangle t that is neither end of the edge with key `key`. */
+static uint32_t far_corner(const Mesh *m, uint32_t t, uint64_t key)
+{
+    const uint32_t *c = m->tris + 3 * (size_t)t;
+    uint32_t lo = (uint32_t)(key >> 32), hi = (uint32_t)key;
+    for (int k = 0; k < 3; k++)
+        if (c[k] != lo && c[k] != hi) return c[k];
+    return c[0];
+}
+
+int mesh_part_convex(const Mesh *m, uint32_t first, uint32_t n, double tol)
+{
+    if (n < 4 || n > (UINT32_MAX >> 1) || first > m->ntris || n > m->ntris - first) return 0;
+    size_t ne = 3 * (size_t)n;
+    Edge *edges = malloc(ne * sizeof *edges);
+    uint32_t *parent = malloc((size_t)n * sizeof *parent);
+    uint32_t *verts = malloc(ne * sizeof *verts);
+    int convex = edges && parent && verts;
+    for (uint32_t i = 0; i < n && convex; i++) {
+        const uint32_t *t = m->tris + 3 * (size_t)(first + i);
+        parent[i] = i;
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = t[k], b = t[(k + 1) % 3];
+            if (a >= m->nverts || a == b) convex = 0;
+            Edge *ed = &edges[3 * (size_t)i + (size_t)k];
+            ed->key = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+            ed->tri_dir = i * 2 + (a > b);
+            verts[3 * (size_t)i + (size_t)k] = a;
+        }
+    }
+    if (convex) qsort(edges, ne, sizeof *edges, compare_edges);
+    for (size_t s = 0; convex && s < ne; s += 2) {
+        /* exactly two uses, in opposite directions (sorted: forward first) */
+        if (s + 1 >= ne || edges[s + 1].key != edges[s].key ||
+            (s + 2 < ne && edges[s + 2].key == edges[s].key) ||
+            (edges[s].tri_dir & 1) == (edges[s + 1].tri_dir & 1)) {
+            convex = 0;
+            break;
+        }
+        uint32_t ta = edges[s].tri_dir >> 1, tb = edges[s + 1].tri_dir >> 1;
+        for (int side = 0; side < 2 && convex; side++) {
+            uint32_t t = side ? tb : ta, o = side ? ta : tb;
+            double len, h = plane_side(m, first + t, far_corner(m, first + o, edges[s].key), &len);
+            convex = len > 0.0 && h < -tol * len;
+        }
+        uint32_t ra = uf_root(parent, ta), rb = uf_root(parent, tb);
+        parent[ra] = rb;
+    }
+    for (uint32_t i = 1; convex && i < n; i++) convex = uf_root(parent, i) == uf_root(parent, 0);
+    if (convex) { /* genus 0: V - E + F = 2 */
+        qsort(verts, ne, sizeof *verts, cmp_u32_mesh);
+        size_t nv = 0;
+        for (size_t i = 0; i < ne; i++) nv += i == 0 || verts[i] != verts[i - 1];
+        convex = (long long)nv - (long long)(ne / 2) + (long long)n == 2;
+    }
+    free(edges);
+    free(parent);
+    free(verts);
+    return convex;
 }
 
 int mesh_check_closed(const Mesh *m, char *err, size_t errlen)

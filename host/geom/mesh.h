@@ -53,6 +53,18 @@ int mesh_load_head(const char *path, Mesh *out, char *head, size_t headlen, char
  * Returns 0, or -1 with a message naming one offending edge (its two vertex positions). */
 int mesh_check_closed(const Mesh *m, char *err, size_t errlen);
 
+/* Whether triangles first .. first + n - 1 of m bound a convex volume, tested edge by edge
+ * in O(n log n): they form one closed surface of genus 0 (every edge, between vertex
+ * indices, used by exactly two of them in opposite directions; connected; V - E + F = 2),
+ * and at every edge the far corner of each triangle lies behind the other's plane by more
+ * than tol (strictly convex edges, in double precision). A closed connected surface that
+ * is locally convex everywhere bounds a convex body (Hadamard; for polyhedra, the convex
+ * edges make every vertex's cone convex), so every vertex then lies behind every
+ * triangle's plane. Meshes with repeated vertex positions under other indices, flat edges
+ * (coplanar neighbours) or degenerate triangles count as not convex. Returns 1 or 0 (also
+ * when out of memory). */
+int mesh_part_convex(const Mesh *m, uint32_t first, uint32_t n, double tol);
+
 /* Triangles [first, first + ntris) of mesh: one object, or one element of a texture. */
 typedef struct MeshPart {
     const Mesh *mesh;
