@@ -57,10 +57,11 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen);
  * in O(n log n): they form one closed surface of genus 0 (every edge, between vertex
  * indices, used by exactly two of them in opposite directions; connected; V - E + F = 2),
  * and at every edge the far corner of each triangle lies behind the other's plane by more
- * than tol (strictly convex edges, in double precision). A closed connected surface that
- * is locally convex everywhere bounds a convex body (Hadamard; for polyhedra, the convex
- * edges make every vertex's cone convex), so every vertex then lies behind every
- * triangle's plane. Meshes with repeated vertex positions under other indices, flat edges
+ * than tol (strictly convex edges, in double precision). A closed connected immersed
+ * surface that is locally convex everywhere bounds a convex body (Hadamard), so every
+ * vertex then lies behind every triangle's plane; convex edges make a vertex's cone convex
+ * where its faces go round it once, which is assumed, not tested (docs/architecture.md,
+ * "The shadow cone test"). Meshes with repeated vertex positions under other indices, flat edges
  * (coplanar neighbours) or degenerate triangles count as not convex. Returns 1 or 0 (also
  * when out of memory). */
 int mesh_part_convex(const Mesh *m, uint32_t first, uint32_t n, double tol);
