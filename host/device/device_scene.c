@@ -327,26 +327,6 @@ static void object_spread(const Mesh *m, uint32_t first, uint32_t n, const doubl
         }
 }
 
-/* The unnormalised normal of triangle t of m, (v1 - v0) x (v2 - v0) in double precision,
- * into x; returns v0. */
-static vec3 tri_normal_d(const Mesh *m, uint32_t t, double x[3])
-{
-    vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
-         p2 = m->verts[m->tris[3 * t + 2]];
-    double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
-    double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
-    x[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    x[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    x[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    return p0;
-}
-
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Whether every vertex of triangles first .. first + n - 1 of m and of the texture's
  * tex_first .. tex_first + tex_n - 1 lies behind (or within eps of) the plane of each of
  * the first ones (counter-clockwise seen from the front): a convex surface with its
@@ -366,13 +346,13 @@ static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex
         uint32_t u = q < n ? first + q : tex_first + (q - n);
         for (int j = 0; j < 3; j++) vi[3 * (size_t)q + j] = m->tris[3 * u + j];
     }
-    qsort(vi, nv, sizeof *vi, cmp_u32);
+    qsort(vi, nv, sizeof *vi, mesh_cmp_u32);
     for (size_t i = 0; i < nv; i++)
         if (k == 0 || vi[i] != vi[k - 1]) vi[k++] = vi[i];
     int convex = 1;
     for (uint32_t t = first; t < first + n && convex; t++) {
         double x[3];
-        vec3 p0 = tri_normal_d(m, t, x);
+        vec3 p0 = mesh_tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         if (!(len > 0.0)) {
             convex = 0;
@@ -428,7 +408,7 @@ static void object_bounds(const Mesh *m, uint32_t first, uint32_t n, uint32_t te
     double nrm[3] = {0, 0, 0}, best = 0.0, k = 0.0;
     for (uint32_t t = first; t < first + n; t++) {
         double x[3];
-        vec3 p0 = tri_normal_d(m, t, x);
+        vec3 p0 = mesh_tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         if (len > best) {
             best = len;
@@ -543,7 +523,7 @@ static int part_core(const Mesh *m, uint32_t first, uint32_t n, double margin, f
     double r = INFINITY;
     for (uint32_t t = first; t < first + n; t++) {
         double x[3];
-        vec3 p0 = tri_normal_d(m, t, x);
+        vec3 p0 = mesh_tri_normal_d(m, t, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         double h = (x[0] * (c[0] - p0.x) + x[1] * (c[1] - p0.y) + x[2] * (c[2] - p0.z)) / len;
         if (!(h < 0.0)) return 0;
@@ -564,7 +544,7 @@ static int core_inside(const Mesh *m, float core[4], uint32_t host, uint32_t hos
     double r = core[3];
     for (uint32_t h = host; h < host + host_n; h++) {
         double x[3];
-        vec3 p0 = tri_normal_d(m, h, x);
+        vec3 p0 = mesh_tri_normal_d(m, h, x);
         double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
         if (!(len > 0.0)) return 0;
         double d =

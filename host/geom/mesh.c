@@ -194,7 +194,7 @@ typedef struct Edge {
     uint32_t tri_dir;
 } Edge;
 
-static int cmp_u32_mesh(const void *a, const void *b)
+int mesh_cmp_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
@@ -297,17 +297,25 @@ static uint32_t uf_root(uint32_t *parent, uint32_t i)
     return i;
 }
 
+vec3 mesh_tri_normal_d(const Mesh *m, uint32_t t, double n[3])
+{
+    vec3 p0 = m->verts[m->tris[3 * t]], p1 = m->verts[m->tris[3 * t + 1]],
+         p2 = m->verts[m->tris[3 * t + 2]];
+    double e1[3] = {p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+    double e2[3] = {p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    return p0;
+}
+
 /* Signed distance (times the normal's length) of vertex v from the plane of triangle t. */
 static double plane_side(const Mesh *m, uint32_t t, uint32_t v, double *len)
 {
-    const uint32_t *c = m->tris + 3 * (size_t)t;
-    vec3 a = m->verts[c[0]], b = m->verts[c[1]], d = m->verts[c[2]], p = m->verts[v];
-    double e1[3] = {(double)b.x - a.x, (double)b.y - a.y, (double)b.z - a.z};
-    double e2[3] = {(double)d.x - a.x, (double)d.y - a.y, (double)d.z - a.z};
-    double nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2],
-           nz = e1[0] * e2[1] - e1[1] * e2[0];
-    *len = sqrt(nx * nx + ny * ny + nz * nz);
-    return nx * ((double)p.x - a.x) + ny * ((double)p.y - a.y) + nz * ((double)p.z - a.z);
+    double n[3];
+    vec3 a = mesh_tri_normal_d(m, t, n), p = m->verts[v];
+    *len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return n[0] * ((double)p.x - a.x) + n[1] * ((double)p.y - a.y) + n[2] * ((double)p.z - a.z);
 }
 
 /* The corner of triangle t that is neither end of the edge with key `key`. */
@@ -360,7 +368,7 @@ int mesh_part_convex(const Mesh *m, uint32_t first, uint32_t n, double tol)
     }
     for (uint32_t i = 1; convex && i < n; i++) convex = uf_root(parent, i) == uf_root(parent, 0);
     if (convex) { /* genus 0: V - E + F = 2 */
-        qsort(verts, ne, sizeof *verts, cmp_u32_mesh);
+        qsort(verts, ne, sizeof *verts, mesh_cmp_u32);
         size_t nv = 0;
         for (size_t i = 0; i < ne; i++) nv += i == 0 || verts[i] != verts[i - 1];
         convex = (long long)nv - (long long)(ne / 2) + (long long)n == 2;

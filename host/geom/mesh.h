@@ -53,6 +53,13 @@ int mesh_load_head(const char *path, Mesh *out, char *head, size_t headlen, char
  * Returns 0, or -1 with a message naming one offending edge (its two vertex positions). */
 int mesh_check_closed(const Mesh *m, char *err, size_t errlen);
 
+/* The first corner of triangle t of m, and in n its normal (edge 1 x edge 2, unnormalised,
+ * in double precision from the float edges). */
+vec3 mesh_tri_normal_d(const Mesh *m, uint32_t t, double n[3]);
+
+/* qsort's comparison of two uint32_t. */
+int mesh_cmp_u32(const void *a, const void *b);
+
 /* Whether triangles first .. first + n - 1 of m bound a convex volume, tested edge by edge
  * in O(n log n): they form one closed surface of genus 0 (every edge, between vertex
  * indices, used by exactly two of them in opposite directions; connected; V - E + F = 2),
