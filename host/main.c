@@ -34,8 +34,9 @@ static const char usage_text[] =
     "       vbcl --list-devices\n"
     "\n"
     "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
-    "the extension: .png .jpg .tif (8-bit sRGB) or .exr (linear float). SCENE.json may be\n"
-    "a pipe; - reads it from standard input (mesh paths then start at the current directory).\n"
+    "the extension: .png .jpg .tif (8-bit sRGB), .exr or .pfm (linear float; vbcl writes\n"
+    ".pfm itself, without OpenImageIO). SCENE.json may be a pipe; - reads it from standard\n"
+    "input (mesh paths then start at the current directory).\n"
     "\n"
     "options (each overrides the scene's own setting):\n"
     "  -o, --output FILE        image to write (default: image.output, else SCENE.png);\n"
@@ -352,6 +353,17 @@ static char *output_path(const Options *o, const Scene *s, int frame)
         out = numbered;
     }
     return out;
+}
+
+/* Whether the images this run writes need OpenImageIO: not when each of them is a .pfm,
+ * which vbcl writes itself (a scene's own image textures load it when they are read). s
+ * is the still scene, or NULL for an animation, whose -o names its frames. */
+static int needs_image_library(const Options *o, const Scene *s)
+{
+    const char *out = o->output ? o->output : s ? s->output : NULL;
+    return !out || !image_is_native_format(out) ||
+           (o->aa_map && !image_is_native_format(o->aa_map)) ||
+           (o->aa_samples_map && !image_is_native_format(o->aa_samples_map));
 }
 
 /* Writes each pixel's refinement level (aa_level_colour) or, with samples set, its number
@@ -752,7 +764,8 @@ static int run(Dist *d, int argc, char **argv, double t0)
         rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
         if (rc)
             diag_print(prog, "%s", err);
-        else if (d->rank == 0 || first >= 0) /* the ranks that write images */
+        else if ((d->rank == 0 || first >= 0) /* the ranks that write images */
+                 && needs_image_library(&o, have_still ? &still : NULL))
             image_preload();    /* OpenImageIO loads while the kernels are built and run */
         rc = dist_agree(d, rc); /* every rank has its devices, or all stop */
     }

@@ -116,6 +116,12 @@ static void test_cli_image_plugin(void)
              tu_vbcl, scene, img);
     CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "libOpenImageIO") && file_exists(img),
           "a render loads OpenImageIO and writes %s", img);
+    /* a .pfm vbcl writes itself: a machine without OpenImageIO (a GPU node) still renders */
+    snprintf(img, sizeof img, "%s/plugin.pfm", tu_tmpdir());
+    snprintf(cmd, sizeof cmd, "LD_DEBUG=files timeout 300 %s %s -q -o %s --width 8 --height 8",
+             tu_vbcl, scene, img);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && !strstr(out, "libOpenImageIO") && file_exists(img),
+          "a render to .pfm loads no OpenImageIO and writes %s", img);
 }
 
 /* The kernel cache keeps within VBCL_CACHE_MAX_MB: a cold build that stores its binary
@@ -212,10 +218,12 @@ static void test_cli_renders_and_overrides(void)
     CHECK(strstr(out, "sub-grids") && strstr(out, "(given)"), "--grid TOP:SUB given: %s", out);
     CHECK(strstr(out, "rays        primary 200") != NULL, "--stats counts primary rays: %s", out);
     CHECK(file_exists(img), "image written");
-    /* every output format, read back: 8-bit sRGB ones and linear float EXR agree */
-    const char *exts[] = {"png", "jpg", "tif", "exr"};
-    float *pix[4] = {NULL, NULL, NULL, NULL};
-    for (int i = 0; i < 4; i++) {
+    /* every output format, read back: 8-bit sRGB ones and linear float EXR agree, and the
+     * PFM vbcl writes itself holds the EXR's very floats, rows bottom to top (OpenImageIO
+     * reads it; the image is not square, so a flip or a transposition shows) */
+    const char *exts[] = {"png", "jpg", "tif", "exr", "pfm"};
+    float *pix[5] = {NULL, NULL, NULL, NULL, NULL};
+    for (int i = 0; i < 5; i++) {
         char path[512], err[512];
         int w = 0, h = 0;
         snprintf(path, sizeof path, "%s/fmt.%s", tu_tmpdir(), exts[i]);
@@ -237,7 +245,25 @@ static void test_cli_renders_and_overrides(void)
               worst_png);
         CHECK(worst_jpg <= 0.15, "JPEG close to the EXR (worst %g)", worst_jpg);
     }
-    for (int i = 0; i < 4; i++) free(pix[i]);
+    if (pix[3] && pix[4])
+        CHECK(memcmp(pix[3], pix[4], sizeof(float) * 12 * 8 * 4) == 0,
+              "the PFM's floats are the EXR's");
+    {
+        char path[512], head[16] = "";
+        snprintf(path, sizeof path, "%s/fmt.pfm", tu_tmpdir());
+        FILE *f = fopen(path, "rb");
+        long size = -1;
+        if (f) {
+            size_t k = fread(head, 1, 13, f);
+            head[k] = '\0';
+            fseek(f, 0, SEEK_END);
+            size = ftell(f);
+            fclose(f);
+        }
+        CHECK(strcmp(head, "PF\n12 8\n-1.0\n") == 0 && size == 13 + 12 * 8 * 12,
+              "PFM header (little-endian RGB) and size %ld", size);
+    }
+    for (int i = 0; i < 5; i++) free(pix[i]);
     /* from another working directory: kernels are embedded, mesh paths are scene-relative */
     snprintf(args, sizeof args, "cd / && %s%s -q %s -o %s/good.png",
              tu_vbcl[0] == '/' ? "" : "\"$OLDPWD\"/", tu_vbcl, scene, tu_tmpdir());

@@ -75,7 +75,7 @@ static const char usage_fourier[] =
     "  --z Z               height of the slice (default 0.5)\n"
     "  --extent E          side of the square shown (default 1)\n"
     "  --pixels N          image width and height (default 256)\n"
-    "  -o, --output FILE   image to write (.png .jpg .tif .exr)\n";
+    "  -o, --output FILE   image to write (.png .jpg .tif .exr .pfm)\n";
 
 static const char usage_project[] =
     "usage: vbcl texgen project --image IMG\n"
@@ -192,7 +192,7 @@ static int cmd_fourier(int argc, char **argv)
     if (o.help) return fputs(usage_fourier, stdout), 0;
     const char *out = o.output;
     int pixels = a.pixels;
-    if (!out) return fail(M, "missing -o FILE (expected an image path: .png .jpg .tif .exr)");
+    if (!out) return fail(M, "missing -o FILE (expected an image path: .png .jpg .tif .exr .pfm)");
     if (image_check_path(out, err, sizeof err)) return fail(M, "%s", err);
     VbFourier f;
     if (texgen_fourier_init(&f, a.terms, a.a0, a.freq, a.seed, err, sizeof err))

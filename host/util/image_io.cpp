@@ -26,6 +26,8 @@ extern "C" int image_write(const char *path, int width, int height, const float 
                            float exposure, char *err, size_t errlen)
 {
     if (image_check_path(path, err, errlen)) return -1;
+    if (image_is_native_format(path))
+        return image_write_pfm(path, width, height, rgba, exposure, err, errlen);
     const char *dot = std::strrchr(path, '.'); // image_check_path found an extension
     std::string e(dot + 1);
     for (auto &ch : e) ch = (char)std::tolower((unsigned char)ch);

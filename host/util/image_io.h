@@ -1,5 +1,6 @@
 /* image_io.h — the C interface to OpenImageIO: write a linear float RGB image as PNG,
- * JPEG or TIFF (8-bit sRGB) or EXR (linear float), whole or not at all; read images. */
+ * JPEG or TIFF (8-bit sRGB) or EXR (linear float), whole or not at all; read images. PFM
+ * (linear float) vbcl writes itself, without OpenImageIO (image_pfm.c). */
 #ifndef VBCL_IMAGE_IO_H
 #define VBCL_IMAGE_IO_H
 
@@ -12,8 +13,15 @@ extern "C" {
 /* Returns 0 when path's extension names a format vbcl writes, else -1 with a message. */
 int image_check_path(const char *path, char *err, size_t errlen);
 
-/* Whether path's format keeps linear floats (EXR); the others are 8-bit sRGB. */
+/* Whether path's format keeps linear floats (EXR, PFM); the others are 8-bit sRGB. */
 int image_is_float_format(const char *path);
+
+/* Whether vbcl writes path's format itself (PFM), with no need of OpenImageIO. */
+int image_is_native_format(const char *path);
+
+/* Writes a PFM as image_write does (same scaling, same temporary name and rename). */
+int image_write_pfm(const char *path, int width, int height, const float *rgba, float exposure,
+                    char *err, size_t errlen);
 
 /* Starts loading OpenImageIO on a thread of its own, so that the vbcl binary, which loads
  * it as a plugin (image_plugin.c) rather than at start-up, has it by the time it reads or

@@ -1,5 +1,6 @@
 /* image_path.c — what image_io.h can say of a path without OpenImageIO: whether vbcl
- * writes its format, and whether that format keeps linear floats. */
+ * writes its format, whether that format keeps linear floats, and whether vbcl writes it
+ * without OpenImageIO. */
 #include "image_io.h"
 
 #include <ctype.h>
@@ -22,10 +23,10 @@ int image_check_path(const char *path, char *err, size_t errlen)
     char e[256];
     image_ext(path, e, sizeof e);
     if (!strcmp(e, "png") || !strcmp(e, "jpg") || !strcmp(e, "jpeg") || !strcmp(e, "tif") ||
-        !strcmp(e, "tiff") || !strcmp(e, "exr"))
+        !strcmp(e, "tiff") || !strcmp(e, "exr") || !strcmp(e, "pfm"))
         return 0;
-    snprintf(err, errlen, "%s: unknown image format \"%s\" (expected .png, .jpg, .tif or .exr)",
-             path, e);
+    snprintf(err, errlen,
+             "%s: unknown image format \"%s\" (expected .png, .jpg, .tif, .exr or .pfm)", path, e);
     return -1;
 }
 
@@ -33,5 +34,12 @@ int image_is_float_format(const char *path)
 {
     char e[256];
     image_ext(path, e, sizeof e);
-    return !strcmp(e, "exr");
+    return !strcmp(e, "exr") || !strcmp(e, "pfm");
+}
+
+int image_is_native_format(const char *path)
+{
+    char e[256];
+    image_ext(path, e, sizeof e);
+    return !strcmp(e, "pfm");
 }

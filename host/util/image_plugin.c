@@ -144,7 +144,10 @@ static int plugin_ready(const char *path, char *err, size_t errlen)
 int image_write(const char *path, int width, int height, const float *rgba, float exposure,
                 char *err, size_t errlen)
 {
-    if (image_check_path(path, err, errlen) || plugin_ready(path, err, errlen)) return -1;
+    if (image_check_path(path, err, errlen)) return -1;
+    if (image_is_native_format(path))
+        return image_write_pfm(path, width, height, rgba, exposure, err, errlen);
+    if (plugin_ready(path, err, errlen)) return -1;
     return plugin.write(path, width, height, rgba, exposure, err, errlen);
 }
 
