@@ -41,7 +41,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_aa  # noqa: E402  (installs numpy and matplotlib if missing)
-from bench_aa import np, plt, read_exr, read_stats_json  # noqa: E402
+from bench_aa import np, plt, read_pfm, read_stats_json  # noqa: E402
 
 A4 = "scenes/thesis/a4_two_prisms.json"
 
@@ -179,7 +179,7 @@ def part_thesis(a, out):
         for thr, depth, disp, t_render, t_aa, t_disp, t_total in rows_in:
             scene = disp_scene if disp else A4
             opts = ["--width", str(size), "--height", str(size), "--aa", str(thr),
-                    "--depth", str(depth), "-o", os.path.join(a.tmp, "thesis.exr")] + quick
+                    "--depth", str(depth), "-o", os.path.join(a.tmp, "thesis.pfm")] + quick
             # a deeper tree or dispersion is another program: build it (and let PoCL compile
             # its kernels) first, so that no row includes a cold build: on a tiny image with
             # the row's anti-aliasing, then unrefined at the row's size (PoCL compiles a
@@ -187,7 +187,7 @@ def part_thesis(a, out):
             for warm in (["--width", "8", "--height", "8", "--aa", str(thr)],
                          ["--width", str(size), "--height", str(size), "--aa", "0"]):
                 run_stats(a.vbcl, scene, warm + ["--depth", str(depth), "-o",
-                                                 os.path.join(a.tmp, "warm.exr")])
+                                                 os.path.join(a.tmp, "warm.pfm")])
             st = median_stats(a.vbcl, scene, opts, reps)
             aa = st["aa_contrast_ms"] + st["aa_refine_ms"] + st["aa_reconstruct_ms"]
             rows.append({
@@ -260,7 +260,7 @@ def part_grid(a, out):
         for g in sizes:
             for levels, suffix in GRID_LEVELS:
                 opts = ["--width", str(size), "--height", str(size), "--grid", g + suffix,
-                        "-o", os.path.join(a.tmp, "grid.exr")] + extra
+                        "-o", os.path.join(a.tmp, "grid.pfm")] + extra
                 row = grid_row(label, g, levels, median_stats(a.vbcl, scene, opts, a.repeats))
                 rows.append(row)
                 print(f"grid: {row}", flush=True)
@@ -311,17 +311,17 @@ def part_error(a, out):
     scene = "scenes/prism_dispersion.json"
     w, h = (16, 12) if a.quick else (240, 160)
     ref_bands = 16 if a.quick else 64
-    ref_path = os.path.join(a.tmp, "bands_ref.exr")
+    ref_path = os.path.join(a.tmp, "bands_ref.pfm")
     base = ["--width", str(w), "--height", str(h)]
     ref_st = run_stats(a.vbcl, scene, base + ["--bands", str(ref_bands), "-o", ref_path])
-    ref = np.clip(read_exr(ref_path), 0.0, 1.0)
+    ref = np.clip(read_pfm(ref_path), 0.0, 1.0)
     rows = []
     for nb in (BANDS_QUICK if a.quick else BANDS) + ["thesis"]:
-        img_path = os.path.join(a.tmp, "bands.exr")
+        img_path = os.path.join(a.tmp, "bands.pfm")
         opts = base + ["--bands", str(nb), "-o", img_path]
         run_stats(a.vbcl, scene, opts)  # builds this band count's stack size class
         st = median_stats(a.vbcl, scene, opts, a.repeats)
-        img = np.clip(read_exr(img_path), 0.0, 1.0)
+        img = np.clip(read_pfm(img_path), 0.0, 1.0)
         rmse = float(np.sqrt(np.mean((img - ref) ** 2)))
         rows.append({"bands": nb, "render_ms": f"{st['render_ms']:.1f}",
                      "dispersion_ms": f"{st['dispersion_ms']:.1f}",
@@ -376,13 +376,13 @@ def part_accel(a, out):
     # the grid is data, not code: one program serves every row; build it and compile its
     # kernels (anti-aliasing's too) once
     run_stats(a.vbcl, A4, ["--width", "8", "--height", "8", "--aa", "0.1", "-o",
-                           os.path.join(a.tmp, "warm.exr")])
+                           os.path.join(a.tmp, "warm.pfm")])
     for thr in (1.0, 0.1):
         for g, label in ACCEL_GRIDS:
             if thr != 1.0 and g.endswith(":1"):
                 continue
             opts = ["--width", str(size), "--height", str(size), "--aa", str(thr), "--grid", g,
-                    "-o", os.path.join(a.tmp, "accel.exr")] + quick
+                    "-o", os.path.join(a.tmp, "accel.pfm")] + quick
             st = median_stats(a.vbcl, A4, opts, a.repeats)
             kern = kernel_ms(st)
             rows.append({"threshold": thr, "grid": g, "structure": label, "cells": st["grid"],
@@ -469,12 +469,12 @@ def part_drivers(a, out):
     for label, scene, extra in scenes:
         runs = {index: [] for index, _ in devices}
         for index, _ in devices:  # warm each device's program cache
-            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8",
-                                      "--device", str(index)] + extra)
+            run_stats(a.vbcl, scene, ["--width", "8", "--height", "8", "--device", str(index),
+                                      "-o", os.path.join(a.tmp, "drivers.pfm")] + extra)
         for _ in range(a.repeats):  # the devices interleaved, repeat by repeat
             for index, _ in devices:
                 opts = ["--width", str(size), "--height", str(size), "--device", str(index),
-                        "-o", os.path.join(a.tmp, "drivers.exr")] + extra
+                        "-o", os.path.join(a.tmp, "drivers.pfm")] + extra
                 runs[index].append(run_stats(a.vbcl, scene, opts))
         for index, name in devices:
             rs = sorted(runs[index], key=lambda r: r["total_ms"])

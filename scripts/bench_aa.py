@@ -89,6 +89,20 @@ def read_exr(path):
     return vals[: h * w * c].reshape(h, w, c)[:, :, :3]
 
 
+def read_pfm(path):
+    """Pixels of a PFM (as vbcl writes it: "PF", little- or big-endian floats, rows bottom
+    to top) as a float array (h, w, 3), read with numpy alone."""
+    with open(path, "rb") as f:
+        data = f.read()
+    head = data.split(b"\n", 3)
+    if len(head) < 4 or head[0] != b"PF":
+        raise ValueError(f"{path}: not an RGB PFM")
+    w, h = (int(v) for v in head[1].split())
+    order = "<" if float(head[2]) < 0 else ">"
+    vals = np.frombuffer(head[3], dtype=order + "f4", count=w * h * 3)
+    return vals.reshape(h, w, 3)[::-1].astype(np.float64)
+
+
 def reseeded(scene):
     """A copy of scene beside it (relative mesh paths still resolve) with another seed."""
     with open(scene) as f:

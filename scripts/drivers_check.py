@@ -2,10 +2,15 @@
 """drivers_check.py — `make test-drivers`: the same scenes on two OpenCL drivers, compared.
 
 usage: scripts/drivers_check.py [--vbcl build/vbcl] [--a Portable] [--b Intel] [--only NAME]
+       scripts/drivers_check.py --save DIR --b NVIDIA    (on a machine with device B)
+       scripts/drivers_check.py --against DIR [--a Portable]    (here, on device A)
 
-Renders each scene of SCENES as EXR (linear float) on device A and device B (--device by
+Renders each scene of SCENES as PFM (linear float) on device A and device B (--device by
 name, both visible in this process's environment: `make test-drivers` sources the file
-scripts/intel-ocl.sh writes) and compares the images with the scene's tolerance:
+scripts/intel-ocl.sh writes) and compares the images with the scene's tolerance. Where
+device B is on another machine (a GPU node without PoCL), --save renders B's images
+there into DIR (needs only vbcl, its OpenCL driver, python3 and numpy), and --against
+renders A here and compares with them; the mixed-driver frame is then left out:
 
   tight   values within 1e-6 + REL * max(|a|, |b|) (REL 1e-4 for opaque scenes, 1e-3
           for dielectrics: ray trees compound the few ulps OpenCL allows exp, pow, sqrt and
@@ -34,7 +39,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_aa import np, read_exr  # noqa: E402
+from bench_aa import np, read_pfm  # noqa: E402
 
 SMALL = ["--width", "64", "--height", "64"]
 # name, scene, options, kind ("opaque", "glass" or "chaotic"), FRAC for chaotic scenes
@@ -69,7 +74,7 @@ def render(vbcl, device, scene, opts, out):
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}: exit {r.returncode}: {r.stderr.strip()}")
-    return read_exr(out)
+    return read_pfm(out)
 
 
 def compare(a, b, kind, frac_max):
@@ -99,17 +104,36 @@ def main():
     ap.add_argument("--a", default="Portable", help="first device (--device spec)")
     ap.add_argument("--b", default="Intel", help="second device (--device spec)")
     ap.add_argument("--only", default="", help="only scenes whose name contains this")
+    ap.add_argument("--save", metavar="DIR",
+                    help="render on device B alone into DIR, for --against on another machine")
+    ap.add_argument("--against", metavar="DIR",
+                    help="device B's images are in DIR (made by --save): render A, compare")
     a = ap.parse_args()
+    if a.save and a.against:
+        ap.error("--save and --against exclude each other")
+    remote = a.save or a.against
+    scenes = [(i, *sc) for i, sc in enumerate(SCENES)
+              if (not a.only or a.only in sc[0]) and not (remote and "MIXED" in sc[2])]
+    if a.save:
+        os.makedirs(a.save, exist_ok=True)
     failed = 0
     with tempfile.TemporaryDirectory(prefix="vbcl-drivers-") as tmp:
-        for name, scene, opts, kind, frac in SCENES:
-            if a.only and a.only not in name:
-                continue
+        for i, name, scene, opts, kind, frac in scenes:
+            saved = os.path.join(remote, f"scene{i:02d}.pfm") if remote else None
             try:
                 dev_b = f"{a.a},{a.b}" if "MIXED" in opts else a.b
                 opts = [o for o in opts if o != "MIXED"]
-                img_a = render(a.vbcl, a.a, scene, opts, os.path.join(tmp, "a.exr"))
-                img_b = render(a.vbcl, dev_b, scene, opts, os.path.join(tmp, "b.exr"))
+                if a.save:
+                    render(a.vbcl, dev_b, scene, opts, saved)
+                    print(f"drivers: {name}: rendered on {a.b} into {saved}", flush=True)
+                    continue
+                img_a = render(a.vbcl, a.a, scene, opts, os.path.join(tmp, "a.pfm"))
+                if a.against:
+                    if not os.path.exists(saved):
+                        raise RuntimeError(f"{saved} is missing (no --save render of it)")
+                    img_b = read_pfm(saved)
+                else:
+                    img_b = render(a.vbcl, dev_b, scene, opts, os.path.join(tmp, "b.pfm"))
             except RuntimeError as e:
                 print(f"drivers: {name}: FAILED: {e}", flush=True)
                 failed += 1
@@ -117,8 +141,12 @@ def main():
             ok, text = compare(img_a, img_b, kind, frac)
             print(f"drivers: {name} ({kind}): {'ok' if ok else 'FAILED'}: {text}", flush=True)
             failed += not ok
-    total = sum(1 for s in SCENES if not a.only or a.only in s[0])
-    print(f"drivers: {a.a} against {a.b}: {total - failed} of {total} scenes agree")
+    total = len(scenes)
+    if a.save:
+        print(f"drivers: {total - failed} of {total} scenes rendered on {a.b} into {a.save}")
+    else:
+        other = f"the images in {a.against}" if a.against else a.b
+        print(f"drivers: {a.a} against {other}: {total - failed} of {total} scenes agree")
     return 1 if failed else 0
 
 
