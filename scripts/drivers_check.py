@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """drivers_check.py — `make test-drivers`: the same scenes on two OpenCL drivers, compared.
 
-usage: scripts/drivers_check.py [--vbcl build/vbcl] [--a Portable] [--b Intel] [--only NAME]
+usage: scripts/drivers_check.py [--vbcl build/vbcl] [--a Portable] [--b Intel] [--only REGEX]
        scripts/drivers_check.py --save DIR --b NVIDIA    (on a machine with device B)
        scripts/drivers_check.py --against DIR [--a Portable]    (here, on device A)
 
@@ -34,6 +34,7 @@ drivers").
 """
 import argparse
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -103,7 +104,8 @@ def main():
     ap.add_argument("--vbcl", default="build/vbcl")
     ap.add_argument("--a", default="Portable", help="first device (--device spec)")
     ap.add_argument("--b", default="Intel", help="second device (--device spec)")
-    ap.add_argument("--only", default="", help="only scenes whose name contains this")
+    ap.add_argument("--only", default="",
+                    help="only scenes whose name this regular expression matches (re.search)")
     ap.add_argument("--save", metavar="DIR",
                     help="render on device B alone into DIR, for --against on another machine")
     ap.add_argument("--against", metavar="DIR",
@@ -113,7 +115,7 @@ def main():
         ap.error("--save and --against exclude each other")
     remote = a.save or a.against
     scenes = [(i, *sc) for i, sc in enumerate(SCENES)
-              if (not a.only or a.only in sc[0]) and not (remote and "MIXED" in sc[2])]
+              if (not a.only or re.search(a.only, sc[0])) and not (remote and "MIXED" in sc[2])]
     if a.save:
         os.makedirs(a.save, exist_ok=True)
     failed = 0
