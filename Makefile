@@ -45,8 +45,9 @@ LIB_OBJ  := $(patsubst host/%.c,$(BUILD)/host/%.o,$(filter-out host/main.c $(PLU
             $(patsubst host/%.cpp,$(BUILD)/host/%.o,$(HOST_CXX)) $(BUILD)/kernel_source.o
 MAIN_OBJ := $(BUILD)/host/main.o
 # The vbcl binary: the library without OpenImageIO's file, the plugin's loader, and the
-# plugin (image_io.cpp, image_path.c and image_pfm.c as a shared object) embedded.
-PLUGIN_SRC := host/util/image_io.cpp host/util/image_path.c host/util/image_pfm.c
+# plugin (image_io.cpp, image_path.c, image_pfm.c and fileio.c as a shared object) embedded.
+PLUGIN_SRC := host/util/image_io.cpp host/util/image_path.c host/util/image_pfm.c \
+              host/util/fileio.c
 VBCL_OBJ := $(MAIN_OBJ) $(filter-out $(BUILD)/host/util/image_io.o,$(LIB_OBJ)) \
             $(BUILD)/host/util/image_plugin.o $(BUILD)/image_plugin_blob.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))

@@ -19,7 +19,7 @@ int image_is_float_format(const char *path);
 /* Whether vbcl writes path's format itself (PFM), with no need of OpenImageIO. */
 int image_is_native_format(const char *path);
 
-/* Writes a PFM as image_write does (same scaling, same temporary name and rename). */
+/* Writes a PFM as image_write does (the same scaling; whole or not at all, by fileio.h). */
 int image_write_pfm(const char *path, int width, int height, const float *rgba, float exposure,
                     char *err, size_t errlen);
 
