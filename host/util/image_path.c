@@ -7,6 +7,18 @@
 #include <stdio.h>
 #include <string.h>
 
+/* The formats vbcl writes, by extension. */
+typedef struct ImageFormat {
+    const char *ext;
+    int linear; /* keeps linear floats (else 8-bit sRGB) */
+    int native; /* written by vbcl itself (image_pfm.c), not by OpenImageIO */
+} ImageFormat;
+
+static const ImageFormat formats[] = {
+    {"png", 0, 0},  {"jpg", 0, 0}, {"jpeg", 0, 0}, {"tif", 0, 0},
+    {"tiff", 0, 0}, {"exr", 1, 0}, {"pfm", 1, 1},
+};
+
 /* The extension of path's file name in lower case ("" without one), cut to fit ext. */
 static void image_ext(const char *path, char *ext, size_t n)
 {
@@ -18,13 +30,19 @@ static void image_ext(const char *path, char *ext, size_t n)
     ext[k] = '\0';
 }
 
+/* path's format, or NULL when vbcl writes none by its extension (put in e). */
+static const ImageFormat *image_format(const char *path, char *e, size_t n)
+{
+    image_ext(path, e, n);
+    for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++)
+        if (!strcmp(e, formats[i].ext)) return &formats[i];
+    return NULL;
+}
+
 int image_check_path(const char *path, char *err, size_t errlen)
 {
     char e[256];
-    image_ext(path, e, sizeof e);
-    if (!strcmp(e, "png") || !strcmp(e, "jpg") || !strcmp(e, "jpeg") || !strcmp(e, "tif") ||
-        !strcmp(e, "tiff") || !strcmp(e, "exr") || !strcmp(e, "pfm"))
-        return 0;
+    if (image_format(path, e, sizeof e)) return 0;
     snprintf(err, errlen,
              "%s: unknown image format \"%s\" (expected .png, .jpg, .tif, .exr or .pfm)", path, e);
     return -1;
@@ -33,13 +51,13 @@ int image_check_path(const char *path, char *err, size_t errlen)
 int image_is_float_format(const char *path)
 {
     char e[256];
-    image_ext(path, e, sizeof e);
-    return !strcmp(e, "exr") || !strcmp(e, "pfm");
+    const ImageFormat *f = image_format(path, e, sizeof e);
+    return f && f->linear;
 }
 
 int image_is_native_format(const char *path)
 {
     char e[256];
-    image_ext(path, e, sizeof e);
-    return !strcmp(e, "pfm");
+    const ImageFormat *f = image_format(path, e, sizeof e);
+    return f && f->native;
 }
