@@ -49,7 +49,7 @@ typedef struct SceneObject {
 enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
 
 /* render.aa_floor's default: the least a + b of the contrast test (display units). */
-#define SCENE_AA_FLOOR 0.0f
+#define SCENE_AA_FLOOR 1.0f
 /* render.aa_level_gain's default: the threshold grows by this factor per level. */
 #define SCENE_AA_LEVEL_GAIN 2.0f
 /* render.penumbra_feelers's default and largest value: a power of two, so that the extra
