@@ -260,25 +260,34 @@ static void test_aa_untouched_pixels_unchanged(void)
 }
 
 /* --ssaa 1 goes through the supersampling path and gives the plain render bit for bit;
- * render.aa in the scene is the same as --aa; option errors exit 2. */
+ * render.aa (and aa_max_level, aa_level_gain, aa_floor) in the scene is the same as the
+ * options; the floor's default is 1; option errors exit 2. */
 static void test_aa_options(void)
 {
     if (!tu_device()) {
         th_skip("no OpenCL device");
         return;
     }
-    AaRender plain, one, cli, key;
+    AaRender plain, one, cli, key, dflt, floor1, floor0;
     if (aa_render("opt_plain", "", 0, &plain) || aa_render("opt_ssaa1", "--ssaa 1", 0, &one) ||
-        aa_render("opt_cli", "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5", 1, &cli))
+        aa_render("opt_cli", "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5 --aa-floor 0.5", 1,
+                  &cli) ||
+        aa_render("opt_default", "--aa 0.4", 0, &dflt) ||
+        aa_render("opt_floor1", "--aa 0.4 --aa-floor 1", 0, &floor1) ||
+        aa_render("opt_floor0", "--aa 0.4 --aa-floor 0", 0, &floor0))
         return;
     CHECK(rmse(&plain, &one) == 0.0, "--ssaa 1 differs from the plain render: %g",
           rmse(&plain, &one));
+    /* the floor's default is 1 (SCENE_AA_FLOOR), and on this scene's dark edges it matters */
+    CHECK(rmse(&dflt, &floor1) == 0.0, "the default floor is not 1: %g", rmse(&dflt, &floor1));
+    CHECK(rmse(&dflt, &floor0) > 0.0, "--aa-floor 0 changes nothing at --aa 0.4");
     /* the scene with render.aa set instead of the option */
     char cmd[2048], log[8192], out[512];
     snprintf(out, sizeof out, "%s/aa_key.exr", tu_tmpdir());
     snprintf(cmd, sizeof cmd,
              "sed 's/\"ambient\": \\[1, 1, 1\\]/\"ambient\": [1, 1, 1], \"aa\": 0.1, "
-             "\"aa_max_level\": 3, \"aa_level_gain\": 1.5/' %s > %s/aa_key.json && "
+             "\"aa_max_level\": 3, \"aa_level_gain\": 1.5, \"aa_floor\": 0.5/' %s > "
+             "%s/aa_key.json && "
              "%s %s/aa_key.json -q -o %s",
              AA_SCENE, tu_tmpdir(), tu_vbcl, tu_tmpdir(), out);
     int rc = tu_run(cmd, log, sizeof log);
@@ -308,6 +317,9 @@ static void test_aa_options(void)
     aa_free(&plain);
     aa_free(&one);
     aa_free(&cli);
+    aa_free(&dflt);
+    aa_free(&floor1);
+    aa_free(&floor0);
 }
 
 /* The nested sample positions (kernels/aa_tree.h), checked over every node: a node's
