@@ -211,8 +211,9 @@ static int compare_edges(const void *pa, const void *pb)
  * memory. A least-significant-digit radix sort on the key, 16 bits a pass, skipping a pass
  * whose digit is the same in every key; it keeps equal keys in their order, which is
  * compare_edges's since the edges come in triangle order and no triangle has two edges
- * with one key. On the 245,760 edges of an 81,920-triangle sphere it takes a tenth of
- * qsort's time. */
+ * with one key. Loading glass_bombed_sphere (an 81,920-triangle ball, 245,760 edges) it
+ * took 0.8% of the process's perf samples; before it, glibc's merge sort (every qsort of
+ * the process) and compare_edges took 5.0%. */
 static int sort_edges(Edge *edges, size_t n)
 {
     enum { DIGITS = 1 << 16 };
