@@ -207,23 +207,24 @@ static int compare_edges(const void *pa, const void *pb)
     return (a->tri_dir > b->tri_dir) - (a->tri_dir < b->tri_dir);
 }
 
-/* Sorts edges into compare_edges's order, or returns -1 (edges untouched) when out of
- * memory. A least-significant-digit radix sort on the key, 16 bits a pass, skipping a pass
- * whose digit is the same in every key; it keeps equal keys in their order, which is
- * compare_edges's since the edges come in triangle order and no triangle has two edges
- * with one key. Loading glass_bombed_sphere (an 81,920-triangle ball, 245,760 edges) it
- * took 0.8% of the process's perf samples; before it, glibc's merge sort (every qsort of
- * the process) and compare_edges took 5.0%. */
-static int sort_edges(Edge *edges, size_t n)
+/* Sorts edges into compare_edges's order: a least-significant-digit radix sort on the
+ * key, 16 bits a pass, skipping a pass whose digit is the same in every key; it keeps equal
+ * keys in their order, which is compare_edges's since the edges come in triangle order and
+ * no triangle has two edges with one key. Loading glass_bombed_sphere (an 81,920-triangle
+ * ball, 245,760 edges) it took 0.8% of the process's perf samples; before it, glibc's merge
+ * sort (every qsort of the process) and compare_edges took 5.0%. Without memory for its
+ * buffers, qsort. */
+static void sort_edges(Edge *edges, size_t n)
 {
     enum { DIGITS = 1 << 16 };
-    if (n < 2) return 0;
+    if (n < 2) return;
     Edge *tmp = malloc(n * sizeof *tmp);
     size_t *start = malloc(DIGITS * sizeof *start);
     if (!tmp || !start) {
         free(tmp);
         free(start);
-        return -1;
+        qsort(edges, n, sizeof *edges, compare_edges);
+        return;
     }
     Edge *src = edges, *dst = tmp;
     for (int shift = 0; shift < 64; shift += 16) {
@@ -244,7 +245,6 @@ static int sort_edges(Edge *edges, size_t n)
     if (src != edges) memcpy(edges, src, n * sizeof *edges);
     free(tmp);
     free(start);
-    return 0;
 }
 
 static void format_edge(char *buf, size_t len, vec3 a, vec3 b)
@@ -386,7 +386,7 @@ int mesh_part_convex(const Mesh *m, uint32_t first, uint32_t n, double tol)
             ed->tri_dir = i * 2 + (a > b);
         }
     }
-    if (convex && sort_edges(edges, ne) < 0) qsort(edges, ne, sizeof *edges, compare_edges);
+    if (convex) sort_edges(edges, ne);
     for (size_t s = 0; convex && s < ne; s += 2) {
         /* exactly two uses, in opposite directions (sorted: forward first) */
         if (s + 1 >= ne || edges[s + 1].key != edges[s].key ||
@@ -439,7 +439,7 @@ int mesh_check_closed(const Mesh *m, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory checking the mesh");
     } else if (!collect_edges(m, canon, edges, err, errlen)) {
         size_t ne = (size_t)m->ntris * 3;
-        if (sort_edges(edges, ne) < 0) qsort(edges, ne, sizeof *edges, compare_edges);
+        sort_edges(edges, ne);
         rc = check_edges(m, edges, ne, err, errlen);
     }
     free(canon);
