@@ -76,6 +76,9 @@ static const char usage_text[] =
     "                           the thesis's plain ratio)\n"
     "      --aa-level-gain G    the threshold of a subpixel at level L is THRESHOLD*G^L\n"
     "                           (1..4; default 2; 1: the thesis's, alike at every level)\n"
+    "      --aa-reconstruct nearest|leaves  a refined pixel is the mean of its 16x16 finest\n"
+    "                           cells, each the value of the sample nearest to it\n"
+    "                           (default) or of the leaf covering it (the thesis's)\n"
     "      --bands N|thesis     wavelength bands of a dispersive refraction (1..64), or the\n"
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
@@ -103,7 +106,8 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid, *fresnel, *aa_map, *aa_samples_map, *stats_json;
+    const char *scene, *output, *device, *grid, *fresnel, *aa_reconstruct, *aa_map, *aa_samples_map,
+        *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
@@ -237,7 +241,7 @@ static int option_frames(Options *o, const char *val)
 }
 
 /* The options with a value that need more than a range: --frames, --fresnel, --exposure,
- * --bands. Returns -1 (stored), 2 (usage error) or -2 (a is none of them). */
+ * --bands, --aa-reconstruct. Returns -1 (stored), 2 (usage error) or -2 (a is none of them). */
 static int option_special(Options *o, const char *a, const char *val)
 {
     if (!strcmp(a, "--frames")) return option_frames(o, val);
@@ -245,6 +249,12 @@ static int option_special(Options *o, const char *a, const char *val)
         if (strcmp(val, "exact") && strcmp(val, "thesis"))
             return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
         o->fresnel = val;
+        return -1;
+    }
+    if (!strcmp(a, "--aa-reconstruct")) {
+        if (strcmp(val, "nearest") && strcmp(val, "leaves"))
+            return usage_error("--aa-reconstruct %s: expected nearest or leaves", diag_value(val));
+        o->aa_reconstruct = val;
         return -1;
     }
     if (!strcmp(a, "--exposure")) {
@@ -264,7 +274,7 @@ static int option_special(Options *o, const char *a, const char *val)
 static int is_special_option(const char *a)
 {
     return !strcmp(a, "--frames") || !strcmp(a, "--fresnel") || !strcmp(a, "--exposure") ||
-           !strcmp(a, "--bands");
+           !strcmp(a, "--bands") || !strcmp(a, "--aa-reconstruct");
 }
 
 /* Reads the command line into o. Returns -1 to go on and render, or an exit status (0
@@ -406,6 +416,9 @@ static int apply_options(const Options *o, Scene *s)
     if (o->aa >= 0) s->aa_threshold = (float)o->aa;
     if (o->aa_floor >= 0) s->aa_floor = (float)o->aa_floor;
     if (o->aa_level_gain > 0) s->aa_level_gain = (float)o->aa_level_gain;
+    if (o->aa_reconstruct)
+        s->aa_reconstruct =
+            strcmp(o->aa_reconstruct, "leaves") == 0 ? SCENE_AA_LEAVES : SCENE_AA_NEAREST;
     if (o->no_cone_test) s->shadow_cone_test = 0;
     if (o->all_feelers) s->shadow_by_weight = 0;
     if (o->penumbra_feelers > 0) s->penumbra_feelers = o->penumbra_feelers;

@@ -92,9 +92,9 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
     if (!(s->aa_threshold > 0.0f)) return;
     fprintf(f,
             "anti-alias  adaptive quadtree, threshold %g (x %g per level), floor %g, max level %d, "
-            "%d rounds; pixels refined to level",
+            "reconstruct %s, %d rounds; pixels refined to level",
             (double)s->aa_threshold, (double)s->aa_level_gain, (double)s->aa_floor, s->aa_max_level,
-            st->aa_rounds);
+            s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves" : "nearest", st->aa_rounds);
     for (int l = 1; l <= s->aa_max_level; l++)
         fprintf(f, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
                 l < s->aa_max_level ? "," : "\n");
@@ -309,6 +309,11 @@ static void json_samples(cJSON *root, const Scene *s, const RenderStats *st, int
     fnum(o, "floor", adaptive ? s->aa_floor : 0.0f, ok);
     fnum(o, "level_gain", adaptive ? s->aa_level_gain : 0.0f, ok);
     num(o, "max_level", adaptive ? s->aa_max_level : 0, ok);
+    str(o, "reconstruct",
+        !adaptive                              ? "none"
+        : s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves"
+                                               : "nearest",
+        ok);
     num(o, "rounds", st->aa_rounds, ok);
     cJSON *a = arr(o, "refined_per_level", ok);
     for (int l = 1; a && adaptive && l <= s->aa_max_level; l++)

@@ -6,7 +6,9 @@
  * Storage: a pixel nobody refined is its film value (level 0). A refined pixel owns a tree
  * slot of 256 float4 finest cells; each cell holds the value of the leaf that covers it
  * (rgb) and that leaf's level (w). A leaf at level L covers 4^(4-L) cells, so the
- * area-weighted mean of the leaves is the plain mean of the cells. */
+ * area-weighted mean of the leaves is the plain mean of the cells; the default
+ * reconstruction instead weighs each leaf's sample by the cells nearest to it
+ * (aa_nearest_weights). */
 #ifndef VBCL_AA_CL
 #define VBCL_AA_CL
 
@@ -127,6 +129,105 @@ VB_INLINE uint aa_sample_id(uint pixel, int side, uint sub)
 {
     if (side == 1) return pixel;
     return vb_hash(pixel ^ vb_hash(((uint)side << 16) ^ sub ^ 0x5bd1e995u));
+}
+
+/* The leaves of a tree slot, in cell order: leaf[i] = x | y << 8 | first cell << 16 |
+ * level << 24, (x, y) its sample's position in half-cells from the pixel's corner (exact: a
+ * cell's centre is odd, the pixel centre is 16, 16), the first cell the one holding its
+ * value. Returns their
+ * number; *deepest gets the deepest level. */
+VB_INLINE int aa_leaf_list(__global const float *cells, uint *leaf, int *deepest)
+{
+    int n = 0;
+    for (int k = 0; k < VBCL_AA_CELLS; k++) {
+        int lv = (int)cells[4 * k + 3], s = AA_TREE_SIDE >> lv;
+        int fx = k % AA_TREE_SIDE, fy = k / AA_TREE_SIDE;
+        *deepest = max(*deepest, lv);
+        if (fx % s || fy % s) continue;
+        int at = aa_node_sample_cell(lv, fx / s, fy / s);
+        uint hx =
+            at == AA_TREE_CENTRE_CELL ? (uint)AA_TREE_SIDE : 2u * (uint)(at % AA_TREE_SIDE) + 1u;
+        uint hy =
+            at == AA_TREE_CENTRE_CELL ? (uint)AA_TREE_SIDE : 2u * (uint)(at / AA_TREE_SIDE) + 1u;
+        leaf[n++] = hx | hy << 8 | (uint)k << 16 | (uint)lv << 24;
+    }
+    return n;
+}
+
+/* The squared distance in half-cells from a cell's centre (cx, cy) to the sample of leaf
+ * code l (aa_leaf_list): an exact integer. */
+VB_INLINE int aa_sample_d2(uint l, int cx, int cy)
+{
+    int dx = (int)(l & 255u) - cx, dy = (int)(l >> 8 & 255u) - cy;
+    return dx * dx + dy * dy;
+}
+
+/* The weights of the n leaves' samples (aa_leaf_list) for a pixel's value: w[i] is the
+ * number of finest cells whose centre lies nearer to sample i than to any other, a cell
+ * equally near to m samples counted 1/m to each (the areas of the samples' Voronoi cells
+ * over the pixel, at the resolution of the cells). Over the 256 cells they sum to 256.
+ * Leaf by leaf: no sample is nearer to a cell of the leaf than the leaf's own sample is
+ * to its farthest cell, so the candidates for all its cells are the samples lying in the
+ * cells within that distance of the leaf (held: the leaf whose sample lies in each cell,
+ * the pixel centre's in cell (8, 8)), or every leaf where those cells are more. A pixel
+ * split once has the same four samples every time. Scalar code: oclgrind 21.10 computed a
+ * search over every leaf written in int4 or int16 lanes wrongly where PoCL ran it right. */
+VB_INLINE void aa_nearest_weights(const uint *leaf, int n, float *w)
+{
+    if (n == 4) { /* children (0, 0), (1, 0), (0, 1) and (1, 1), which keeps the centre */
+        w[0] = 54.0f;
+        w[1] = 60.0f;
+        w[2] = 60.0f;
+        w[3] = 82.0f;
+        return;
+    }
+    short held[VBCL_AA_CELLS], cand[VBCL_AA_CELLS];
+    for (int k = 0; k < VBCL_AA_CELLS; k++) held[k] = -1;
+    for (int i = 0; i < n; i++) {
+        held[(int)(leaf[i] >> 8 & 255u) / 2 * AA_TREE_SIDE + (int)(leaf[i] & 255u) / 2] = (short)i;
+        w[i] = 0.0f;
+    }
+    for (int i = 0; i < n; i++) {
+        int first = (int)(leaf[i] >> 16 & 255u), s = AA_TREE_SIDE >> (int)(leaf[i] >> 24);
+        int hx = (int)(leaf[i] & 255u), hy = (int)(leaf[i] >> 8 & 255u);
+        int lx = 2 * (first % AA_TREE_SIDE) + 1, ly = 2 * (first / AA_TREE_SIDE) + 1;
+        int hx2 = lx + 2 * (s - 1), hy2 = ly + 2 * (s - 1); /* the last cell centres */
+        int ax = max(abs(lx - hx), abs(hx2 - hx)), ay = max(abs(ly - hy), abs(hy2 - hy));
+        /* a candidate lies within r half-cells of some cell centre of the leaf; a cell's
+         * centre is odd, the pixel centre (even) on the corner of cell (8, 8), hence the 1 */
+        int r = (int)ceil(sqrt((float)(ax * ax + ay * ay))) + 1;
+        int x0 = max(lx - r, 0) / 2, x1 = min(hx2 + r, 2 * AA_TREE_SIDE - 1) / 2;
+        int y0 = max(ly - r, 0) / 2, y1 = min(hy2 + r, 2 * AA_TREE_SIDE - 1) / 2;
+        int m = 0;
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) < n) {
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++)
+                    if (held[y * AA_TREE_SIDE + x] >= 0) cand[m++] = held[y * AA_TREE_SIDE + x];
+        } else {
+            for (int j = 0; j < n; j++) cand[m++] = (short)j;
+        }
+        for (int cy = ly; cy <= hy2; cy += 2)
+            for (int cx = lx; cx <= hx2; cx += 2) {
+                int best = INT_MAX, ties = 0, nearest = i;
+                for (int j = 0; j < m; j++) {
+                    int d = aa_sample_d2(leaf[cand[j]], cx, cy);
+                    if (d < best) {
+                        best = d;
+                        ties = 1;
+                        nearest = cand[j];
+                    } else {
+                        ties += d == best;
+                    }
+                }
+                if (ties == 1) {
+                    w[nearest] += 1.0f;
+                    continue;
+                }
+                float share = 1.0f / (float)ties; /* on a bisector: rare, a second look */
+                for (int j = 0; j < m; j++)
+                    if (aa_sample_d2(leaf[cand[j]], cx, cy) == best) w[cand[j]] += share;
+            }
+    }
 }
 
 /* Writes value (rgb) and level lv into the cells of node `code` of a tree slot. */

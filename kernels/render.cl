@@ -12,7 +12,7 @@
  *   aa_contrast_mark        film, tree         -> marks (quadtree leaves to split)
  *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
  *   aa_split_store          radiance, marks    -> tree (four leaves for each split node)
- *   aa_resolve              tree               -> film, info (mean of each pixel's leaves)
+ *   aa_resolve              tree               -> film, info (each pixel from its samples)
  * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
  * adds the pass, aa_split_rays the pass and the list, with dispersion the tree kernels add
  * the split records, the other aa_* kernels take only their own buffers), are
@@ -447,27 +447,30 @@ __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2
         aa_fill_node(cells, aa_new_child(m.y, k), vload4(3 * j + (uint)k, radiance).xyz, lv);
 }
 
-/* tree, slot_pixels -> film, info: each refined pixel becomes the area-weighted mean of its
- * leaves (the mean of its cells: the box window of figure 4.4 over the pixel's own
- * footprint), and info its deepest level | leaf count << 8. */
+/* tree, slot_pixels -> film, info: each refined pixel becomes the mean of its finest cells
+ * (a box window over the pixel's own footprint, figure 4.4), each cell the value of the
+ * sample nearest to it (aa_nearest_weights) or, with aa->reconstruct 1, of the leaf
+ * covering it (the area-weighted mean of the leaves, the thesis's); info its deepest
+ * level | leaf count << 8. */
 __kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot_pixels,
                          __global const float *tree, __global float *film, __global int *info)
 {
     uint slot = get_global_id(0);
     if (slot >= aa->entries) return;
     __global const float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
+    uint leaf[VBCL_AA_CELLS];
+    float w[VBCL_AA_CELLS];
+    int deepest = 0, n = aa_leaf_list(cells, leaf, &deepest);
     float3 sum = (float3)(0.0f);
-    int deepest = 0, leaves = 0;
-    for (int k = 0; k < VBCL_AA_CELLS; k++) {
-        float4 c = vload4(k, cells);
-        int lv = (int)c.w, s = AA_TREE_SIDE >> lv;
-        sum += c.xyz;
-        deepest = max(deepest, lv);
-        leaves += (k % AA_TREE_SIDE) % s == 0 && (k / AA_TREE_SIDE) % s == 0;
+    if (aa->reconstruct == 1) { /* each cell holds the value of the leaf covering it */
+        for (int k = 0; k < VBCL_AA_CELLS; k++) sum += vload4(k, cells).xyz;
+    } else {
+        aa_nearest_weights(leaf, n, w);
+        for (int i = 0; i < n; i++) sum += w[i] * vload4(leaf[i] >> 16 & 255u, cells).xyz;
     }
     int p = slot_pixels[slot];
     vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
-    info[p] = deepest | leaves << 8;
+    info[p] = deepest | n << 8;
 }
 
 #ifdef VBCL_TEST_KERNELS

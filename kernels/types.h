@@ -229,9 +229,9 @@ typedef struct VbLeafQuad {
 #define VBCL_GRID_LIST     (1u | 1u << VBCL_GRID_SUB_BITS | 1u << (2 * VBCL_GRID_SUB_BITS))
 
 /* Anti-aliasing (thesis 4.1.2): each pixel is the root of a quadtree of subpixels down to
- * level VBCL_AA_MAX_LEVEL (16x16); a leaf holds one sample, and the pixel is the
- * area-weighted mean of its leaves (kernels/aa_tree.h). Level 0 is the ray through the
- * pixel's centre. */
+ * level VBCL_AA_MAX_LEVEL (16x16); a leaf holds one sample (kernels/aa_tree.h), and the
+ * pixel is the mean of its 16x16 finest cells, each the value of the nearest sample or of
+ * its leaf (VbAaPass.reconstruct). Level 0 is the ray through the pixel's centre. */
 #define VBCL_AA_MAX_LEVEL 4   /* 16x16 subpixels, the thesis's bound */
 #define VBCL_AA_CELLS     256 /* finest cells per pixel: (2^VBCL_AA_MAX_LEVEL)^2 */
 
@@ -248,7 +248,7 @@ typedef struct VbAaPass {
     unsigned int entries; /* batch: entries in it */
     int round;            /* adaptive: the round (0, 1, ...) of this contrast pass or batch */
     float level_gain;     /* a leaf at level L fails at threshold * level_gain^L */
-    unsigned int pad[1];
+    int reconstruct;      /* aa_resolve: 0 the nearest samples, 1 the leaves (SCENE_AA_*) */
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */
@@ -335,7 +335,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
     X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
-    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(sizeof(VbSplit))    \
+    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
 /* clang-format on */
@@ -397,6 +397,7 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, floor) == 24, aapass_floor);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 28, aapass_first);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, level_gain) == 40, aapass_level_gain);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, reconstruct) == 44, aapass_reconstruct);
 
 /* The counter list's indices: distinct (their bits' sum equals their union), clear of the
  * reserved index 0 and below the by-depth counters. */

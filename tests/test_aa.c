@@ -260,33 +260,43 @@ static void test_aa_untouched_pixels_unchanged(void)
 }
 
 /* --ssaa 1 goes through the supersampling path and gives the plain render bit for bit;
- * render.aa (and aa_max_level, aa_level_gain, aa_floor) in the scene is the same as the
- * options; the floor's default is 1; option errors exit 2. */
+ * render.aa (and aa_max_level, aa_level_gain, aa_floor, aa_reconstruct) in the scene is
+ * the same as the options; the floor's default is 1, the reconstruction's nearest; option
+ * errors exit 2. */
 static void test_aa_options(void)
 {
     if (!tu_device()) {
         th_skip("no OpenCL device");
         return;
     }
-    AaRender plain, one, cli, key, dflt, floor1, floor0;
+    AaRender plain, one, cli, key, dflt, floor1, floor0, nearest, leaves;
     if (aa_render("opt_plain", "", 0, &plain) || aa_render("opt_ssaa1", "--ssaa 1", 0, &one) ||
-        aa_render("opt_cli", "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5 --aa-floor 0.5", 1,
-                  &cli) ||
+        aa_render("opt_cli",
+                  "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5 --aa-floor 0.5 "
+                  "--aa-reconstruct leaves",
+                  1, &cli) ||
         aa_render("opt_default", "--aa 0.4", 0, &dflt) ||
         aa_render("opt_floor1", "--aa 0.4 --aa-floor 1", 0, &floor1) ||
-        aa_render("opt_floor0", "--aa 0.4 --aa-floor 0", 0, &floor0))
+        aa_render("opt_floor0", "--aa 0.4 --aa-floor 0", 0, &floor0) ||
+        aa_render("opt_nearest", "--aa 0.4 --aa-reconstruct nearest", 0, &nearest) ||
+        aa_render("opt_leaves", "--aa 0.4 --aa-reconstruct leaves", 0, &leaves))
         return;
     CHECK(rmse(&plain, &one) == 0.0, "--ssaa 1 differs from the plain render: %g",
           rmse(&plain, &one));
     /* the floor's default is 1 (SCENE_AA_FLOOR), and on this scene's dark edges it matters */
     CHECK(rmse(&dflt, &floor1) == 0.0, "the default floor is not 1: %g", rmse(&dflt, &floor1));
     CHECK(rmse(&dflt, &floor0) > 0.0, "--aa-floor 0 changes nothing at --aa 0.4");
+    /* the reconstruction's default is the nearest samples', and it is not the leaves' */
+    CHECK(rmse(&dflt, &nearest) == 0.0, "the default reconstruction is not nearest: %g",
+          rmse(&dflt, &nearest));
+    CHECK(rmse(&dflt, &leaves) > 0.0, "--aa-reconstruct leaves changes nothing at --aa 0.4");
     /* the scene with render.aa set instead of the option */
     char cmd[2048], log[8192], out[512];
     snprintf(out, sizeof out, "%s/aa_key.exr", tu_tmpdir());
     snprintf(cmd, sizeof cmd,
              "sed 's/\"ambient\": \\[1, 1, 1\\]/\"ambient\": [1, 1, 1], \"aa\": 0.1, "
-             "\"aa_max_level\": 3, \"aa_level_gain\": 1.5, \"aa_floor\": 0.5/' %s > "
+             "\"aa_max_level\": 3, \"aa_level_gain\": 1.5, \"aa_floor\": 0.5, "
+             "\"aa_reconstruct\": \"leaves\"/' %s > "
              "%s/aa_key.json && "
              "%s %s/aa_key.json -q -o %s",
              AA_SCENE, tu_tmpdir(), tu_vbcl, tu_tmpdir(), out);
@@ -306,7 +316,8 @@ static void test_aa_options(void)
                          "--aa-samples-map s.png",
                          "--aa 0.1 --aa-map m.bmp",
                          "--aa 0.1 --aa-floor 3",
-                         "--aa 0.1 --aa-level-gain 0.5"};
+                         "--aa 0.1 --aa-level-gain 0.5",
+                         "--aa 0.1 --aa-reconstruct mean"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(cmd, sizeof cmd, "%s %s -q -o %s/never.png %s", tu_vbcl, AA_SCENE, tu_tmpdir(),
                  bad[i]);
@@ -320,6 +331,8 @@ static void test_aa_options(void)
     aa_free(&dflt);
     aa_free(&floor1);
     aa_free(&floor0);
+    aa_free(&nearest);
+    aa_free(&leaves);
 }
 
 /* The nested sample positions (kernels/aa_tree.h), checked over every node: a node's
@@ -601,6 +614,145 @@ static void test_aa_neighbour_rule_across_levels(void)
     fixture_close(&fx);
 }
 
+/* A leaf's sample in half-cells of its pixel (kernels/aa.cl, aa_leaf_list): a cell's centre
+ * is odd, the pixel centre 16. */
+static void resolve_sample_half(unsigned code, int *hx, int *hy)
+{
+    int cell = aa_node_sample_cell(aa_node_level(code), aa_node_x(code), aa_node_y(code));
+    *hx = cell == AA_TREE_CENTRE_CELL ? AA_TREE_SIDE : 2 * (cell % AA_TREE_SIDE) + 1;
+    *hy = cell == AA_TREE_CENTRE_CELL ? AA_TREE_SIDE : 2 * (cell / AA_TREE_SIDE) + 1;
+}
+
+/* The reconstruction (aa_resolve), run on trees made here: random refinements of a pixel
+ * (as in the test above) whose leaves get random values. With reconstruct 1 each pixel is
+ * the mean of its 256 finest cells, each the value of the leaf covering it (the leaves'
+ * area-weighted mean); with 0 (the default) each cell takes the value of the sample
+ * nearest to its centre, a cell equally near to several the mean of theirs, computed here
+ * in double by a search of its own. First a pixel split once, by hand: its centre sample
+ * (kept by the child at (1, 1)) is nearest to 82 of the 256 cells, the new samples of the
+ * children (0, 0), (1, 0) and (0, 1) to 54, 60 and 60 (the leaves' weights would be 64
+ * each). info is the deepest level | leaves << 8. */
+static void test_aa_resolve_nearest_samples(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
+                          "\"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}}, "
+                          "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    enum { TREES = 101 };
+    static float tree[TREES * VBCL_AA_CELLS * 4];
+    static unsigned leaves[TREES][VBCL_AA_CELLS];
+    static float value[TREES][VBCL_AA_CELLS];
+    int nleaves[TREES], deepest[TREES], pixels[TREES];
+    unsigned rng = 2024;
+    for (int t = 0; t < TREES; t++) {
+        int n = 1;
+        leaves[t][0] = aa_node_code(0, 0, 0);
+        int steps = t == 0 ? 1 : 1 + t % 60;
+        for (int step = 0; step < steps; step++) {
+            rng = rng * 1103515245u + 12345u;
+            int i = t == 0 ? 0 : (int)((rng >> 8) % (unsigned)n);
+            unsigned node = leaves[t][i];
+            if (aa_node_level(node) == VBCL_AA_MAX_LEVEL) continue;
+            int lv = aa_node_level(node);
+            int keep = aa_node_sample_cell(lv, aa_node_x(node), aa_node_y(node));
+            for (int j = 0; j < 3; j++) leaves[t][n++] = aa_new_child(node, j);
+            for (int c = 0; c < 4; c++) { /* the child that keeps the sample replaces node */
+                unsigned ch = aa_node_code(lv + 1, 2 * aa_node_x(node) + (c & 1),
+                                           2 * aa_node_y(node) + (c >> 1));
+                if (aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch)) == keep)
+                    leaves[t][i] = ch;
+            }
+        }
+        nleaves[t] = n;
+        deepest[t] = 0;
+        pixels[t] = t;
+        for (int i = 0; i < n; i++) {
+            unsigned c = leaves[t][i];
+            rng = rng * 1103515245u + 12345u;
+            value[t][i] = t == 0 ? (c == aa_node_code(1, 1, 1) ? 1.0f : 0.0f)
+                                 : (float)((rng >> 8) % 1000u) / 250.0f; /* 0 .. 4 */
+            int lv = aa_node_level(c), s = AA_TREE_SIDE >> lv;
+            deepest[t] = lv > deepest[t] ? lv : deepest[t];
+            for (int y = aa_node_y(c) * s; y < (aa_node_y(c) + 1) * s; y++)
+                for (int x = aa_node_x(c) * s; x < (aa_node_x(c) + 1) * s; x++) {
+                    float *cell =
+                        tree + ((size_t)t * VBCL_AA_CELLS + (size_t)(y * AA_TREE_SIDE + x)) * 4;
+                    cell[0] = value[t][i];
+                    cell[1] = 0.5f * value[t][i];
+                    cell[2] = 1.0f - value[t][i];
+                    cell[3] = (float)lv;
+                }
+        }
+    }
+    for (int mode = 0; mode < 2; mode++) {
+        float film[TREES * 4];
+        int info[TREES];
+        VbAaPass pass;
+        memset(&pass, 0, sizeof pass);
+        pass.entries = TREES;
+        pass.reconstruct = mode;
+        memset(film, 0, sizeof film);
+        memset(info, 0, sizeof info);
+        cl_mem m[5] = {buffer(&pass, sizeof pass), buffer(pixels, sizeof pixels),
+                       buffer(tree, sizeof tree), buffer(film, sizeof film),
+                       buffer(info, sizeof info)};
+        const size_t sz[5] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
+                              sizeof(cl_mem)};
+        const void *v[5] = {&m[0], &m[1], &m[2], &m[3], &m[4]};
+        if (run_kernel(fx.r.program, "aa_resolve", TREES, 5, sz, v) == 0) {
+            read_buffer(m[3], film, sizeof film);
+            read_buffer(m[4], info, sizeof info);
+            int bad = 0, bad_info = 0;
+            double worst = 0.0;
+            for (int t = 0; t < TREES; t++) {
+                double want = 0.0;
+                for (int k = 0; k < VBCL_AA_CELLS; k++) {
+                    int cx = 2 * (k % AA_TREE_SIDE) + 1, cy = 2 * (k / AA_TREE_SIDE) + 1;
+                    double best = 1e30, sum = 0.0;
+                    int ties = 0;
+                    for (int i = 0; i < nleaves[t]; i++) {
+                        unsigned c = leaves[t][i];
+                        int s = AA_TREE_SIDE >> aa_node_level(c);
+                        int in = k % AA_TREE_SIDE / s == aa_node_x(c) &&
+                                 k / AA_TREE_SIDE / s == aa_node_y(c);
+                        int hx, hy;
+                        resolve_sample_half(c, &hx, &hy);
+                        double d =
+                            mode ? (in ? 0.0 : 1e29)
+                                 : (double)(hx - cx) * (hx - cx) + (double)(hy - cy) * (hy - cy);
+                        if (d < best) {
+                            best = d;
+                            sum = 0.0;
+                            ties = 0;
+                        }
+                        if (d == best) {
+                            sum += value[t][i];
+                            ties++;
+                        }
+                    }
+                    want += sum / ties;
+                }
+                want /= VBCL_AA_CELLS;
+                double err = fabs(film[4 * t] - want);
+                worst = err > worst ? err : worst;
+                bad += err > 1e-5 * (1.0 + want);
+                bad_info += info[t] != (deepest[t] | nleaves[t] << 8);
+            }
+            CHECK(bad == 0 && bad_info == 0,
+                  "reconstruct %d: %d of %d pixels off their cells' mean (worst %.3g), %d infos "
+                  "wrong",
+                  mode, bad, TREES, worst, bad_info);
+            double split_once = mode ? 64.0 / 256.0 : 82.0 / 256.0;
+            CHECK(fabs(film[0] - split_once) < 1e-6 && fabs(film[2] - (1.0 - split_once)) < 1e-6,
+                  "reconstruct %d, a pixel split once: the centre sample weighs %.6f, not %.6f",
+                  mode, film[0], split_once);
+        }
+        for (int i = 0; i < 5; i++) clReleaseMemObject(m[i]);
+    }
+    fixture_close(&fx);
+}
+
 void suite_aa(void)
 {
     RUN_TEST(test_aa_error_falls_with_threshold);
@@ -609,4 +761,5 @@ void suite_aa(void)
     RUN_TEST(test_aa_options);
     RUN_TEST(test_aa_samples_nested_never_retraced);
     RUN_TEST(test_aa_neighbour_rule_across_levels);
+    RUN_TEST(test_aa_resolve_nearest_samples);
 }

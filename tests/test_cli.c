@@ -608,6 +608,10 @@ static void test_cli_bad_input_classes(void)
     expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
                " \"render\": {\"penumbra_feelers\": 3}}",
                NULL, "render.penumbra_feelers"); /* not a power of two */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
+               " \"render\": {\"aa_reconstruct\": \"mean\"}}",
+               NULL, "render.aa_reconstruct"); /* not a reconstruction */
+    expect_bad(GOOD_SCENE, "--aa-reconstruct box", "--aa-reconstruct box");
     expect_bad(GOOD_SCENE, "--penumbra-feelers 6", "--penumbra-feelers 6");
     expect_bad(GOOD_SCENE, "--grid 0", "--grid");        /* bad option */
     expect_bad(GOOD_SCENE, "--grid 4:65", "SUB 1..64");  /* sub-grid too fine */

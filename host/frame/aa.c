@@ -3,7 +3,8 @@
  * compacts them into one list; the list is traced in full batches of three new samples
  * per marked node (aa_split_rays, the frame's tracing kernels, aa_split_store), and this
  * repeats until nothing is marked; aa_resolve then makes each refined pixel the mean of
- * its leaves. Uniform supersampling (--ssaa) traces N x N samples of every pixel. */
+ * its finest cells, each the value of the nearest sample (or of its leaf). Uniform
+ * supersampling (--ssaa) traces N x N samples of every pixel. */
 #include "aa.h"
 
 #include <math.h>
@@ -192,7 +193,7 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
     return 0;
 }
 
-/* Ends refinement: each refined pixel becomes the mean of its leaves (aa_resolve), the
+/* Ends refinement: each refined pixel becomes the mean of its cells (aa_resolve), the
  * film and each pixel's deepest level and leaf count come back, and st gets the samples
  * per pixel (max) and the pixels that reached each level. Returns 0 or -1. */
 static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned slots,
@@ -279,6 +280,7 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     pass->threshold = s->aa_threshold;
     pass->floor = s->aa_floor;
     pass->level_gain = s->aa_level_gain;
+    pass->reconstruct = s->aa_reconstruct;
     pass->contrast_scale = exp2f(s->exposure);
     pass->max_level = s->aa_max_level;
     pass->width = s->width;

@@ -28,8 +28,10 @@ typedef struct AaState {
  * the leaves that fail the contrast test (threshold s->aa_threshold, floor s->aa_floor)
  * against an adjacent leaf at their level or deeper, and splits them in four (three new
  * samples each, traced by r's kernels), until nothing is marked; leaves at s->aa_max_level
- * never split. rgba becomes the area-weighted mean of each pixel's leaves; pixels never
- * split keep their pass-0 value bit for bit. Leaves each pixel's deepest level and leaf
+ * never split. rgba becomes the mean of each refined pixel's finest cells, each the value of
+ * the nearest sample (s->aa_reconstruct SCENE_AA_NEAREST) or of its leaf (SCENE_AA_LEAVES,
+ * the area-weighted mean of the leaves); pixels never split keep their pass-0 value bit
+ * for bit. Leaves each pixel's deepest level and leaf
  * count in aa, and the counts and times in st; with progress set, reports on stderr once
  * refinement has taken a second. Returns 0, or 1 (device) / 2 (the image or its trees do
  * not fit the device's buffers) with a message in err. */

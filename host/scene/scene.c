@@ -210,10 +210,19 @@ static int get_resolution(Ctx *c, const cJSON *j, const char *key, int max_axis,
     return 0;
 }
 
-/* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain: adaptive
- * anti-aliasing. */
+/* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain,
+ * render.aa_reconstruct: adaptive anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
+    const cJSON *rc = cJSON_GetObjectItemCaseSensitive(j, "aa_reconstruct");
+    if (rc) {
+        if (cJSON_IsString(rc) && strcmp(rc->valuestring, "nearest") == 0)
+            s->aa_reconstruct = SCENE_AA_NEAREST;
+        else if (cJSON_IsString(rc) && strcmp(rc->valuestring, "leaves") == 0)
+            s->aa_reconstruct = SCENE_AA_LEAVES;
+        else
+            return scene_fail(c, "render.aa_reconstruct", "expected \"nearest\" or \"leaves\"");
+    }
     return json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
            json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
                         &s->aa_max_level) ||
@@ -236,6 +245,8 @@ static int get_bool(Ctx *c, const cJSON *j, const char *key, int *v)
     return 0;
 }
 
+/* The render object: its keys, every setting's default, then the values it gives.
+ * Long: one line per key and per default, as clang-format lays the lists out. */
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {"max_depth",
@@ -250,6 +261,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "aa_max_level",
                                        "aa_floor",
                                        "aa_level_gain",
+                                       "aa_reconstruct",
                                        "bands",
                                        "shadow_jitter",
                                        "subgrid",
@@ -271,6 +283,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
     s->aa_floor = SCENE_AA_FLOOR;
     s->aa_level_gain = SCENE_AA_LEVEL_GAIN;
+    s->aa_reconstruct = SCENE_AA_NEAREST;
     s->ssaa = 1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;

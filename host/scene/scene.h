@@ -48,6 +48,11 @@ typedef struct SceneObject {
 /* How energy splits at an interface (render.fresnel). */
 enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
 
+/* How a refined pixel is made of its samples (render.aa_reconstruct): each finest cell the
+ * value of the nearest sample, or of the leaf covering it (the thesis's area-weighted mean
+ * of the leaves). The values are VbAaPass.reconstruct's. */
+enum { SCENE_AA_NEAREST = 0, SCENE_AA_LEAVES = 1 };
+
 /* render.aa_floor's default: the least a + b of the contrast test (display units). */
 #define SCENE_AA_FLOOR 1.0f
 /* render.aa_level_gain's default: the threshold grows by this factor per level. */
@@ -94,6 +99,7 @@ typedef struct Scene {
     int aa_max_level;     /* deepest refinement level: 2^level x 2^level samples (1..4) */
     float aa_floor;       /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
     float aa_level_gain;  /* a leaf at level L fails at aa_threshold * gain^L (1: the thesis) */
+    int aa_reconstruct;   /* SCENE_AA_NEAREST or SCENE_AA_LEAVES */
     int ssaa;             /* uniform N x N supersampling (command line only); 1: off */
     int bands;            /* render.bands: wavelength bands of a dispersive split */
     int band_layout;      /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
