@@ -169,18 +169,11 @@ VB_INLINE int aa_sample_d2(uint l, int cx, int cy)
  * Leaf by leaf: no sample is nearer to a cell of the leaf than the leaf's own sample is
  * to its farthest cell, so the candidates for all its cells are the samples lying in the
  * cells within that distance of the leaf (held: the leaf whose sample lies in each cell,
- * the pixel centre's in cell (8, 8)), or every leaf where those cells are more. A pixel
- * split once has the same four samples every time. Scalar code: oclgrind 21.10 computed a
- * search over every leaf written in int4 or int16 lanes wrongly where PoCL ran it right. */
+ * the pixel centre's in cell (8, 8)), or every leaf where those cells are more. Scalar code:
+ * oclgrind 21.10 computed a search over every leaf written in int4 or int16 lanes wrongly where
+ * PoCL ran it right. */
 VB_INLINE void aa_nearest_weights(const uint *leaf, int n, float *w)
 {
-    if (n == 4) { /* children (0, 0), (1, 0), (0, 1) and (1, 1), which keeps the centre */
-        w[0] = 54.0f;
-        w[1] = 60.0f;
-        w[2] = 60.0f;
-        w[3] = 82.0f;
-        return;
-    }
     short held[VBCL_AA_CELLS], cand[VBCL_AA_CELLS];
     for (int k = 0; k < VBCL_AA_CELLS; k++) held[k] = -1;
     for (int i = 0; i < n; i++) {

@@ -335,6 +335,21 @@ static void test_aa_options(void)
     aa_free(&leaves);
 }
 
+/* Splits leaves[i] of a list of *n quadtree leaves: its three new children are appended and
+ * the child that keeps its sample takes its place. */
+static void split_leaf(unsigned *leaves, int *n, int i)
+{
+    unsigned node = leaves[i];
+    int lv = aa_node_level(node);
+    int keep = aa_node_sample_cell(lv, aa_node_x(node), aa_node_y(node));
+    for (int j = 0; j < 3; j++) leaves[(*n)++] = aa_new_child(node, j);
+    for (int c = 0; c < 4; c++) {
+        unsigned ch =
+            aa_node_code(lv + 1, 2 * aa_node_x(node) + (c & 1), 2 * aa_node_y(node) + (c >> 1));
+        if (aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch)) == keep) leaves[i] = ch;
+    }
+}
+
 /* The nested sample positions (kernels/aa_tree.h), checked over every node: a node's
  * sample cell lies inside it; of its four children exactly one holds the node's sample,
  * the three new children (aa_new_child) are the other three, each with its sample inside
@@ -381,19 +396,11 @@ static void test_aa_samples_nested_never_retraced(void)
             int i = (int)((rng >> 8) % (unsigned)nleaves);
             unsigned n = leaves[i];
             if (aa_node_level(n) == VBCL_AA_MAX_LEVEL) continue;
-            int lv = aa_node_level(n), keep = aa_node_sample_cell(lv, aa_node_x(n), aa_node_y(n));
-            for (int j = 0; j < 3; j++) {
-                unsigned ch = aa_new_child(n, j);
-                traced[ntraced++] =
-                    (unsigned)aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch));
-                leaves[nleaves++] = ch;
-            }
-            for (int c = 0; c < 4; c++) { /* the child that keeps the sample replaces n */
-                unsigned ch =
-                    aa_node_code(lv + 1, 2 * aa_node_x(n) + (c & 1), 2 * aa_node_y(n) + (c >> 1));
-                if (aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch)) == keep)
-                    leaves[i] = ch;
-            }
+            int before = nleaves;
+            split_leaf(leaves, &nleaves, i);
+            for (int j = before; j < nleaves; j++) /* the three new samples */
+                traced[ntraced++] = (unsigned)aa_node_sample_cell(
+                    aa_node_level(leaves[j]), aa_node_x(leaves[j]), aa_node_y(leaves[j]));
         }
         int dup = 0, unmatched = 0;
         for (int a = 0; a < ntraced; a++)
@@ -652,17 +659,7 @@ static void test_aa_resolve_nearest_samples(void)
         for (int step = 0; step < steps; step++) {
             rng = rng * 1103515245u + 12345u;
             int i = t == 0 ? 0 : (int)((rng >> 8) % (unsigned)n);
-            unsigned node = leaves[t][i];
-            if (aa_node_level(node) == VBCL_AA_MAX_LEVEL) continue;
-            int lv = aa_node_level(node);
-            int keep = aa_node_sample_cell(lv, aa_node_x(node), aa_node_y(node));
-            for (int j = 0; j < 3; j++) leaves[t][n++] = aa_new_child(node, j);
-            for (int c = 0; c < 4; c++) { /* the child that keeps the sample replaces node */
-                unsigned ch = aa_node_code(lv + 1, 2 * aa_node_x(node) + (c & 1),
-                                           2 * aa_node_y(node) + (c >> 1));
-                if (aa_node_sample_cell(lv + 1, aa_node_x(ch), aa_node_y(ch)) == keep)
-                    leaves[t][i] = ch;
-            }
+            if (aa_node_level(leaves[t][i]) < VBCL_AA_MAX_LEVEL) split_leaf(leaves[t], &n, i);
         }
         nleaves[t] = n;
         deepest[t] = 0;

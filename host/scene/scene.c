@@ -210,20 +210,27 @@ static int get_resolution(Ctx *c, const cJSON *j, const char *key, int max_axis,
     return 0;
 }
 
+/* render.<key>, when present: the string name0 (0) or name1 (1) into *v. */
+static int get_choice(Ctx *c, const cJSON *j, const char *key, const char *name0, const char *name1,
+                      int *v)
+{
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, key);
+    if (!b) return 0;
+    if (cJSON_IsString(b) && (!strcmp(b->valuestring, name0) || !strcmp(b->valuestring, name1))) {
+        *v = strcmp(b->valuestring, name0) != 0;
+        return 0;
+    }
+    char path[64];
+    snprintf(path, sizeof path, "render.%s", key);
+    return scene_fail(c, path, "expected \"%s\" or \"%s\"", name0, name1);
+}
+
 /* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain,
  * render.aa_reconstruct: adaptive anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
-    const cJSON *rc = cJSON_GetObjectItemCaseSensitive(j, "aa_reconstruct");
-    if (rc) {
-        if (cJSON_IsString(rc) && strcmp(rc->valuestring, "nearest") == 0)
-            s->aa_reconstruct = SCENE_AA_NEAREST;
-        else if (cJSON_IsString(rc) && strcmp(rc->valuestring, "leaves") == 0)
-            s->aa_reconstruct = SCENE_AA_LEAVES;
-        else
-            return scene_fail(c, "render.aa_reconstruct", "expected \"nearest\" or \"leaves\"");
-    }
-    return json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
+    return get_choice(c, j, "aa_reconstruct", "nearest", "leaves", &s->aa_reconstruct) ||
+           json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
            json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
                         &s->aa_max_level) ||
            json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor) ||
@@ -245,8 +252,6 @@ static int get_bool(Ctx *c, const cJSON *j, const char *key, int *v)
     return 0;
 }
 
-/* The render object: its keys, every setting's default, then the values it gives.
- * Long: one line per key and per default, as clang-format lays the lists out. */
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {"max_depth",
@@ -312,17 +317,9 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->seed = (unsigned)seed;
     if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
         get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||
-        get_bool(c, j, "shadow_by_weight", &s->shadow_by_weight))
+        get_bool(c, j, "shadow_by_weight", &s->shadow_by_weight) ||
+        get_choice(c, j, "fresnel", "exact", "thesis", &s->fresnel)) /* SCENE_FRESNEL_* */
         return -1;
-    const cJSON *fr = cJSON_GetObjectItemCaseSensitive(j, "fresnel");
-    if (fr) {
-        if (cJSON_IsString(fr) && strcmp(fr->valuestring, "exact") == 0)
-            s->fresnel = SCENE_FRESNEL_EXACT;
-        else if (cJSON_IsString(fr) && strcmp(fr->valuestring, "thesis") == 0)
-            s->fresnel = SCENE_FRESNEL_THESIS;
-        else
-            return scene_fail(c, "render.fresnel", "expected \"exact\" or \"thesis\"");
-    }
     if (get_resolution(c, j, "grid", GRID_MAX_AXIS, s->grid_res) ||
         get_resolution(c, j, "subgrid", GRID_SUB_MAX_AXIS, s->subgrid_res))
         return -1;
