@@ -134,8 +134,7 @@ VB_INLINE uint aa_sample_id(uint pixel, int side, uint sub)
 /* The leaves of a tree slot, in cell order: leaf[i] = x | y << 8 | first cell << 16 |
  * level << 24, (x, y) its sample's position in half-cells from the pixel's corner (exact: a
  * cell's centre is odd, the pixel centre is 16, 16), the first cell the one holding its
- * value. Returns their
- * number; *deepest gets the deepest level. */
+ * value. Returns their number; *deepest gets the deepest level. */
 VB_INLINE int aa_leaf_list(__global const float *cells, uint *leaf, int *deepest)
 {
     int n = 0;
