@@ -53,6 +53,8 @@ static const char usage_text[] =
     "                           (1..64) in every cell with 2 or more; :1 = one level only\n"
     "      --grid-density D     cells per triangle for --grid auto\n"
     "      --subgrid-density D  sub-cells per triangle of a crowded top cell (default 2)\n"
+    "      --no-camera-tiles    camera rays walk the grid instead of testing the triangles\n"
+    "                           of their image tile nearest first (same image, slower)\n"
     "      --shadow-samples N   shadow feelers per light per point (nearest square)\n"
     "      --seed N             seed of the feelers' jitter (0..2147483647; default 1)\n"
     "      --no-cone-test       trace every feeler, also where the cone from the point to\n"
@@ -112,7 +114,7 @@ typedef struct Options {
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
-    int list_devices, stats, quiet, no_cone_test, all_feelers, penumbra_feelers;
+    int list_devices, stats, quiet, no_cone_test, no_camera_tiles, all_feelers, penumbra_feelers;
 } Options;
 
 static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -187,6 +189,7 @@ static const OptionSpec option_specs[] = {
     {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
     {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
     {"--no-cone-test", NULL, OPT_FLAG, offsetof(Options, no_cone_test), 0, 0},
+    {"--no-camera-tiles", NULL, OPT_FLAG, offsetof(Options, no_camera_tiles), 0, 0},
     {"--all-feelers", NULL, OPT_FLAG, offsetof(Options, all_feelers), 0, 0},
     {"--penumbra-feelers", NULL, OPT_INT, offsetof(Options, penumbra_feelers), 1,
      SCENE_PENUMBRA_FEELERS_MAX},
@@ -420,6 +423,7 @@ static int apply_options(const Options *o, Scene *s)
         s->aa_reconstruct =
             strcmp(o->aa_reconstruct, "leaves") == 0 ? SCENE_AA_LEAVES : SCENE_AA_NEAREST;
     if (o->no_cone_test) s->shadow_cone_test = 0;
+    if (o->no_camera_tiles) s->camera_tiles = 0;
     if (o->all_feelers) s->shadow_by_weight = 0;
     if (o->penumbra_feelers > 0) s->penumbra_feelers = o->penumbra_feelers;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;

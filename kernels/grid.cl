@@ -319,26 +319,32 @@ VB_INLINE uint vb_count4(int4 m)
     return (uint)(-(m.s0 + m.s1 + m.s2 + m.s3));
 }
 
+/* Tests the triangles of one quad for the closest hit, four at a time (quad_candidates) and
+ * then each lane the quad's test leaves in on its own (quad_lane_hit), updating *c. Returns
+ * the number of triangles tested. */
+VB_INLINE uint quad_closest(const RayShear *rs, float3 org, float tmax,
+                            __global const VbTriangle *tris, __global const VbLeafQuad *q,
+                            Closest *c)
+{
+    int4 id = quad_ids(q);
+    int4 real = id >= 0;
+    QuadShear qs;
+    int4 cand = quad_candidates(rs, q, c->reach, &qs) & real;
+    if (cand.s0) closest_lane(&qs, 0, org, tmax, tris, id.s0, c);
+    if (cand.s1) closest_lane(&qs, 1, org, tmax, tris, id.s1, c);
+    if (cand.s2) closest_lane(&qs, 2, org, tmax, tris, id.s2, c);
+    if (cand.s3) closest_lane(&qs, 3, org, tmax, tris, id.s3, c);
+    return vb_count4(real);
+}
+
 /* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
- * four at a time (quad_candidates) and then each lane the quad's test leaves in on its own
- * (quad_lane_hit), updating *c. Returns the number of triangles tested. */
+ * quad by quad (quad_closest), updating *c. Returns the number of triangles tested. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
                                  __global const VbTriangle *tris, __global const uint *leaf_start,
                                  __global const VbLeafQuad *quads, uint leaf, Closest *c)
 {
     uint begin = leaf_start[leaf], end = leaf_start[leaf + 1], n = 0;
-    for (uint k = begin; k < end; k++) {
-        __global const VbLeafQuad *q = quads + k;
-        int4 id = quad_ids(q);
-        int4 real = id >= 0;
-        n += vb_count4(real);
-        QuadShear qs;
-        int4 cand = quad_candidates(rs, q, c->reach, &qs) & real;
-        if (cand.s0) closest_lane(&qs, 0, org, tmax, tris, id.s0, c);
-        if (cand.s1) closest_lane(&qs, 1, org, tmax, tris, id.s1, c);
-        if (cand.s2) closest_lane(&qs, 2, org, tmax, tris, id.s2, c);
-        if (cand.s3) closest_lane(&qs, 3, org, tmax, tris, id.s3, c);
-    }
+    for (uint k = begin; k < end; k++) n += quad_closest(rs, org, tmax, tris, quads + k, c);
     return n;
 }
 

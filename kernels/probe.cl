@@ -477,7 +477,7 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
     TreeCount cnt = {0};
     cnt.prune_budget = 0.0f;
     int k = 0;
-    if (medium_trace(&sc, org, dir, INFINITY, &state, &ph, &tc, &cnt.passes)) {
+    if (medium_trace(&sc, org, dir, INFINITY, &state, &ph, &tc, &cnt.passes, 0)) {
         TreeRay stack[VB_TREE_STACK];
         int n = 0;
         ShadePoint sp = shade_point_make(&sc, dir, ph.hit, 1u, state, ph.cx.surface);
@@ -485,7 +485,7 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
         while (n > 0) {
             TreeRay tr = stack[--n];
             VbMedium st = tr.medium;
-            if (!medium_trace(&sc, tr.org, tr.dir, INFINITY, &st, &ph, &tc, &cnt.passes)) {
+            if (!medium_trace(&sc, tr.org, tr.dir, INFINITY, &st, &ph, &tc, &cnt.passes, 0)) {
                 if (k < cap) {
                     vstore4((float4)(tr.dir, (float)tr.band), 0, out + 8 * k);
                     vstore4((float4)(tr.weight, (float)tr.depth), 0, out + 8 * k + 4);
@@ -509,16 +509,19 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
  * bench. Point lists hold indices of primary rays whose first interfaces (hits, media) came
  * from scene_intersect_closest, as in a frame. */
 
-/* rays -> hits: the closest hit of each ray through the grid (scene_trace_closest). */
+/* rays -> hits: the closest hit of each ray through the grid (scene_trace_closest), or with
+ * camera set as the renderer finds a camera ray's (camera_trace_closest: its image tile). */
 __kernel void probe_trace_closest(SCENE_KERNEL_ARGS __global const VbRay *rays, int nrays,
-                                  __global VbHit *hits)
+                                  __global VbHit *hits, int camera)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
     DevScene sc = DEV_SCENE;
     VbRay r = rays[i];
     TraceCount tc = {0, 0};
-    hits[i] = scene_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+    float3 org = vb_load3(r.org), dir = vb_load3(r.dir);
+    hits[i] = camera ? camera_trace_closest(&sc, org, dir, r.tmax, &tc)
+                     : scene_trace_closest(&sc, org, dir, r.tmax, &tc);
 }
 
 /* rays -> 1 where something lies on the ray before tmax (scene_trace_any), else 0. */

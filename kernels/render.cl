@@ -111,7 +111,8 @@ __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
     rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)pixel);
 }
 
-/* rays -> hits, media: the closest interface of each ray through the grid, and the
+/* rays -> hits, media: the closest interface of each camera ray (camera_trace_closest: its
+ * image tile's triangles, or the grid), and the
  * medium the ray is in just before it (rays start in the camera's medium). */
 __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
 {
@@ -125,13 +126,14 @@ __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
     PathHit ph;
     uint passes = 0;
     VbHit miss = {r.tmax, -1, 0.0f, 0.0f};
-    hits[i] = medium_trace(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph, &tc, &passes)
-                  ? ph.hit
-                  : miss;
+    hits[i] =
+        medium_trace(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph, &tc, &passes, 1)
+            ? ph.hit
+            : miss;
     media[i] = state;
     if (passes) atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], passes);
 #else
-    hits[i] = scene_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+    hits[i] = camera_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
 #endif
     atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc.steps);
     atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
@@ -208,7 +210,7 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, TreeCount *
         TreeRay tr = stack[--n];
         VbMedium state = tr.medium;
         PathHit ph;
-        if (!medium_trace(sc, tr.org, tr.dir, INFINITY, &state, &ph, tc, &cnt->passes)) {
+        if (!medium_trace(sc, tr.org, tr.dir, INFINITY, &state, &ph, tc, &cnt->passes, 0)) {
             acc += tr.weight * vb_cload3(f->background) *
                    medium_absorb(sc, medium_material(sc, state), INFINITY);
             continue;

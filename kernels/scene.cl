@@ -53,6 +53,36 @@ VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, 
                               sc->leaf_quads, org, dir, tmax, tc);
 }
 
+/* Closest hit of a camera ray (org the eye, dir of unit length) within tmax: the triangles
+ * of the ray's image tile (host/device/camera_tiles.h), nearest first, until the next quad
+ * lies beyond the best hit; the same hit as scene_trace_closest, which rays from elsewhere,
+ * or of a frame without tiles, take. The tile is found from dir; the host widened each
+ * triangle's tiles by a margin for the rounding of that. */
+VB_INLINE VbHit camera_trace_closest(const DevScene *sc, float3 org, float3 dir, float tmax,
+                                     TraceCount *tc)
+{
+    __constant const VbFrame *f = sc->f;
+    __constant const VbCamTiles *ct = &f->cam_tiles;
+    float a = dot(dir, vb_cload3(f->camera.forward));
+    if (ct->nx == 0 || !(a > 0.0f) || any(org != vb_cload3(f->camera.eye)))
+        return scene_trace_closest(sc, org, dir, tmax, tc);
+    float px = (dot(dir, vb_cload3(ct->right_n)) / a + 1.0f) * (0.5f * (float)f->width);
+    float py = (1.0f - dot(dir, vb_cload3(ct->up_n)) / a) * (0.5f * (float)f->height);
+    int tx = clamp(convert_int_sat_rtn(px * (1.0f / VBCL_CAM_TILE)), 0, ct->nx - 1);
+    int ty = clamp(convert_int_sat_rtn(py * (1.0f / VBCL_CAM_TILE)), 0, ct->ny - 1);
+    uint t = (uint)(ty * ct->nx + tx), end = sc->cam_start[t + 1];
+    Closest c;
+    closest_begin(&c, tmax);
+    RayShear rs = ray_shear_make(org, dir);
+    uint tests = 0;
+    /* a hit at t lies t * |dir| from the eye, |dir| = 1 within rounding: 1e-4 is ample */
+    for (uint k = sc->cam_start[t]; k < end && sc->cam_near[k] <= c.reach * 1.0001f; k++)
+        tests += quad_closest(&rs, org, tmax, sc->tris, sc->cam_quads + k, &c);
+    tc->steps++;
+    tc->tests += tests;
+    return c.hit;
+}
+
 /* Whether anything lies on (org, dir) before tmax, triangles whose tag has a bit of `skip`
  * (VBCL_TAG_TEXTURE, or 0) left out. */
 VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float tmax, uint skip,

@@ -196,6 +196,18 @@ typedef struct VbCamera {
     float up[4];      /* scaled by tan(fov/2) */
 } VbCamera;
 
+/* Camera tiles (host/device/camera_tiles.h): the image in squares of VBCL_CAM_TILE pixels,
+ * each with its triangles nearest first, which camera rays test instead of walking the grid.
+ * nx = 0: none. right_n and up_n are the camera's right and up over their squared lengths,
+ * so that a direction d falls on pixel x = (d.right_n / d.forward + 1) width / 2. */
+#define VBCL_CAM_TILE 4
+typedef struct VbCamTiles {
+    float right_n[4];
+    float up_n[4];
+    int nx, ny; /* tiles per row and per column */
+    int pad[2];
+} VbCamTiles;
+
 /* The top level of the two-level grid: bounds, resolution, cell size. */
 typedef struct VbGrid {
     float lo[4];
@@ -276,6 +288,7 @@ typedef struct VbFrame {
     unsigned int penumbra_factor; /* a point whose first feelers toward a light disagree traces
                                    * this many times as many (1: never; light_reflect_area) */
     unsigned int pad[2];
+    VbCamTiles cam_tiles;
 } VbFrame;
 
 /* VbFrame.flags */
@@ -334,7 +347,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -374,7 +387,10 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane_eps) == 44, object_plane_eps);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, hi) == 48, object_hi);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane) == 64, object_plane);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 256, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 304, frame_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, cam_tiles) == 256, frame_cam_tiles);
+VBCL_STATIC_ASSERT(sizeof(VbCamTiles) == 48, cam_tiles_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbCamTiles, nx) == 32, cam_tiles_nx);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, flags) == 236, frame_flags);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, nobjects) == 240, frame_nobjects);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, penumbra_factor) == 244, frame_penumbra_factor);
@@ -423,6 +439,9 @@ VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, c
     X(__global, VbGridCell, grid_cells, grid_cells) /* one per top cell */                         \
     X(__global, uint, leaf_start, leaf_start)       /* offsets of the leaves' quads */             \
     X(__global, VbLeafQuad, leaf_quads, leaf_quads) /* their triangles, four at a time */          \
+    X(__global, uint, cam_start, cam_start)         /* offsets of the camera tiles' quads */       \
+    X(__global, VbLeafQuad, cam_quads, cam_quads)   /* their triangles, nearest first */           \
+    X(__global, float, cam_near, cam_near)          /* per quad: its least distance to the eye */  \
     X(__global, VbMaterial, materials, materials)                                                  \
     X(__global, VbObject, objects, objects)                                                        \
     X(__global, VbLight, lights, lights)                                                           \

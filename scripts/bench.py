@@ -260,7 +260,7 @@ def part_grid(a, out):
         for g in sizes:
             for levels, suffix in GRID_LEVELS:
                 opts = ["--width", str(size), "--height", str(size), "--grid", g + suffix,
-                        "-o", os.path.join(a.tmp, "grid.pfm")] + extra
+                        "--no-camera-tiles", "-o", os.path.join(a.tmp, "grid.pfm")] + extra
                 row = grid_row(label, g, levels, median_stats(a.vbcl, scene, opts, a.repeats))
                 rows.append(row)
                 print(f"grid: {row}", flush=True)
@@ -271,7 +271,7 @@ def part_grid(a, out):
             "two = with automatic sub-grids in crowded top cells, one = `--grid N:1`; 20 is the "
             "thesis's grid (marked in the plot). primary: "
             "camera rays over the intersect "
-            "kernel's time; shading: primary rays plus all shadow feelers over the shading and "
+            "kernel's time (walking the grid: `--no-camera-tiles`); shading: primary rays plus all shadow feelers over the shading and "
             "ray-tree kernels' time; secondary: reflected and transmitted rays over the "
             "ray-tree kernel's time (which also traces their feelers); all: every ray over "
             "all tracing kernels' time.")

@@ -415,6 +415,22 @@ static void test_cli_fixed_feelers(void)
     for (int k = 0; k < 4; k++) free(img[k]);
 }
 
+/* Renders scene at 40 x 40 with 4 feelers and extra options into TMP/TAG.exr (the image in
+ * *img); returns its --stats-json document (the caller deletes it). */
+static cJSON *render_40(const char *scene, const char *tag, const char *opts, float **img, int *w,
+                        int *h)
+{
+    char out[8192], args[2048], path[512], json[512], err[512];
+    snprintf(path, sizeof path, "%s/%s.exr", tu_tmpdir(), tag);
+    snprintf(json, sizeof json, "%s/%s.json", tu_tmpdir(), tag);
+    snprintf(args, sizeof args,
+             "%s -q --width 40 --height 40 --shadow-samples 4 -o %s --stats-json %s %s", scene,
+             path, json, opts);
+    CHECK(vbcl(args, out, sizeof out) == 0, "%s: %s", args, out);
+    if (image_read(path, w, h, img, err, sizeof err)) CHECK(0, "%s", err);
+    return read_json(json);
+}
+
 /* The shadow cone test (light.cl, light_cone_objects) leaves feelers untraced only where
  * tracing them finds nothing: on scenes with planar, convex, textured, transparent and
  * dispersive objects, the image is bit-identical to --no-cone-test's, which traces every
@@ -436,16 +452,8 @@ static void test_cli_cone_test(void)
         double shadow[2] = {0, 0}, clear[2] = {0, 0}, blocked[2] = {0, 0};
         int w = 0, h = 0;
         for (int k = 0; k < 2; k++) {
-            char out[8192], args[2048], path[512], json[512], err[512];
-            snprintf(path, sizeof path, "%s/cone%d.exr", tu_tmpdir(), k);
-            snprintf(json, sizeof json, "%s/cone%d.json", tu_tmpdir(), k);
-            snprintf(args, sizeof args,
-                     "%s -q --width 40 --height 40 --aa 0 --shadow-samples 4 -o %s "
-                     "--stats-json %s%s",
-                     scenes[n], path, json, k ? " --no-cone-test" : "");
-            CHECK(vbcl(args, out, sizeof out) == 0, "%s: %s", args, out);
-            if (image_read(path, &w, &h, &img[k], err, sizeof err)) CHECK(0, "%s", err);
-            cJSON *doc = read_json(json);
+            cJSON *doc = render_40(scenes[n], k ? "cone1" : "cone0",
+                                   k ? "--aa 0 --no-cone-test" : "--aa 0", &img[k], &w, &h);
             shadow[k] = json_num(doc, "rays", "shadow", NULL);
             clear[k] = json_num(doc, "rays", "shadow_clear", NULL);
             blocked[k] = json_num(doc, "rays", "shadow_blocked", NULL);
@@ -469,6 +477,42 @@ static void test_cli_cone_test(void)
         free(img[1]);
     }
     CHECK(blocked_any > 0, "no feeler passed through a solid texture part's core (A.4's spheres)");
+}
+
+/* Camera tiles (camera_trace_closest) find the grid's hits: with anti-aliasing, whose
+ * refinement rays are camera rays too, the image is bit-identical to --no-camera-tiles's on
+ * opaque, textured, transparent and dispersive scenes, and camera rays visit fewer cells. */
+static void test_cli_camera_tiles(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const char *const scenes[] = {
+        "scenes/quickstart.json", "scenes/glass_bombed_sphere.json",
+        "scenes/thesis/a4_two_prisms.json", "scenes/thesis/a5_dispersion.json"};
+    for (size_t n = 0; n < sizeof scenes / sizeof *scenes; n++) {
+        float *img[2] = {NULL, NULL};
+        double cells[2] = {0, 0}, spp = 0;
+        int w = 0, h = 0;
+        for (int k = 0; k < 2; k++) {
+            cJSON *doc = render_40(scenes[n], k ? "ctile1" : "ctile0",
+                                   k ? "--aa 0.1 --no-camera-tiles" : "--aa 0.1", &img[k], &w, &h);
+            cells[k] = json_num(doc, "work", "cells_visited", NULL);
+            spp = json_num(doc, "samples", "per_pixel_mean", NULL);
+            cJSON_Delete(doc);
+        }
+        if (img[0] && img[1]) {
+            double diff = 0;
+            for (int i = 0; i < w * h * 4; i++) diff = fmax(diff, fabs(img[0][i] - img[1][i]));
+            CHECK(diff == 0.0, "%s: camera tiles change the image by up to %g", scenes[n], diff);
+        }
+        CHECK(spp > 1.0, "%s: some pixels refined (%g samples per pixel)", scenes[n], spp);
+        CHECK(cells[0] < cells[1], "%s: cells visited with tiles %g, without %g", scenes[n],
+              cells[0], cells[1]);
+        free(img[0]);
+        free(img[1]);
+    }
 }
 
 /* Renders scene at 48 x 48, one sample per pixel, with extra options; the image in *img,
@@ -881,6 +925,7 @@ void suite_cli(void)
     RUN_TEST(test_cli_frames);
     RUN_TEST(test_cli_fixed_feelers);
     RUN_TEST(test_cli_cone_test);
+    RUN_TEST(test_cli_camera_tiles);
     RUN_TEST(test_cli_feelers_by_weight);
     RUN_TEST(test_cli_stats_json);
 }

@@ -147,6 +147,15 @@ static void compare_grid_brute(const char *label, const char *json, const char *
 
 #define CAM "\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
 
+/* Two spheres over a tilted slab: the rest of a scene after its camera or render entries. */
+#define SPHERES_SCENE                                                                              \
+    "\"materials\": {\"m\": {}}, \"objects\": ["                                                   \
+    "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"                 \
+    "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.4, \"centre\": [2, 1, 0], "               \
+    "\"material\": \"m\"},"                                                                        \
+    "{\"shape\": \"box\", \"size\": [6, 0.2, 6], \"material\": \"m\", \"transform\": "             \
+    "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}"
+
 /* Writes soup.obj: n random triangles in [-2, 2]^3, every eighth one large (up to the
  * scene's size, spanning many cells in front of and behind small ones), the rest small. */
 static void write_triangle_soup(int n, unsigned seed)
@@ -180,13 +189,7 @@ static void write_triangle_soup(int n, unsigned seed)
  * scene is the render object's grid entries. */
 static void test_grid_matches_brute_force(void)
 {
-    static const char *spheres =
-        "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
-        "{\"shape\": \"sphere\", \"level\": 4, \"radius\": 1.5, \"material\": \"m\"},"
-        "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.4, \"centre\": [2, 1, 0], "
-        "\"material\": \"m\"},"
-        "{\"shape\": \"box\", \"size\": [6, 0.2, 6], \"material\": \"m\", \"transform\": "
-        "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}";
+    static const char *spheres = "{" CAM "\"render\": {\"grid\": %s}, " SPHERES_SCENE;
     static const char *vase =
         "{" CAM "\"render\": {\"grid\": %s}, \"materials\": {\"m\": {}}, \"objects\": ["
         "{\"shape\": \"revolution\", \"segments\": 40, \"material\": \"m\","
@@ -237,6 +240,155 @@ static void test_grid_matches_brute_force(void)
     compare_grid_brute("boxes on cell faces", faces, "4, \"subgrid\": [2, 4, 1]", 50000);
     compare_grid_brute("flat scene", flat, "\"auto\"", 50000);
     compare_grid_brute("flat scene", flat, "[4, 1, 4], \"subgrid\": [8, 1, 8]", 50000);
+}
+
+/* Camera rays through random points of the image, as camera_ray makes them from the frame's
+ * camera; every eighth on a border of the image (pixel coordinate 0 or the width, 0 or the
+ * height), where a tile's margin matters most. */
+static void camera_rays(const VbCamera *c, VbRay *rays, int n, unsigned seed)
+{
+    for (int i = 0; i < n; i++) {
+        float sx = 2.0f * frand(&seed) - 1.0f, sy = 1.0f - 2.0f * frand(&seed);
+        if (i % 8 == 1) sx = (i & 16) ? 1.0f : -1.0f;
+        if (i % 8 == 5) sy = (i & 16) ? 1.0f : -1.0f;
+        vec3 d = v3_norm(v3(c->forward[0] + sx * c->right[0] + sy * c->up[0],
+                            c->forward[1] + sx * c->right[1] + sy * c->up[1],
+                            c->forward[2] + sx * c->right[2] + sy * c->up[2]));
+        rays[i] = (VbRay){{c->eye[0], c->eye[1], c->eye[2]}, INFINITY, {d.x, d.y, d.z}, (cl_uint)i};
+    }
+}
+
+/* Hits of n rays by probe_trace_closest: through the grid, or with camera set as camera
+ * rays (camera_trace_closest). */
+static void probe_hits(Fixture *fx, int camera, cl_mem rays, int n, VbHit *out)
+{
+    cl_mem m = buffer(NULL, sizeof *out * (size_t)n);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem), sizeof(int)};
+    const void *v[] = {&rays, &n, &m, &camera};
+    fixture_run_probe(fx, "probe_trace_closest", (size_t)n, 4, sz, v);
+    read_buffer(m, out, sizeof *out * (size_t)n);
+    clReleaseMemObject(m);
+}
+
+/* Camera tiles (camera_trace_closest) against the grid and brute force for the camera of
+ * `json`: the same triangle and distance, bit for bit, as the grid on n rays, and the brute
+ * force's (or a tie at equal distance) on the first nb of them. */
+static void compare_camera_tiles(const char *label, const char *json, int n, int nb)
+{
+    Fixture fx;
+    if (fixture_open(&fx, json)) return;
+    const VbCamTiles *ct = &fx.r.frame_host.cam_tiles;
+    CHECK(ct->nx > 0 && ct->ny > 0, "%s: the scene has camera tiles", label);
+    VbRay *rays = malloc(sizeof *rays * (size_t)n);
+    VbHit *hc = malloc(sizeof *hc * (size_t)n), *hg = malloc(sizeof *hg * (size_t)n);
+    VbHit *hb = malloc(sizeof *hb * (size_t)nb);
+    camera_rays(&fx.r.frame_host.camera, rays, n, 4242u);
+    cl_mem mr = buffer(rays, sizeof *rays * (size_t)n);
+    probe_hits(&fx, 1, mr, n, hc);
+    probe_hits(&fx, 0, mr, n, hg);
+    cl_uint ntris = fx.s.mesh.ntris;
+    cl_mem mb = buffer(NULL, sizeof *hb * (size_t)nb);
+    const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
+                         sizeof(cl_mem)};
+    const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &nb, &mb};
+    run_kernel(fx.r.program, "probe_intersect_brute", (size_t)nb, 5, sz, v);
+    read_buffer(mb, hb, sizeof *hb * (size_t)nb);
+    int hits = 0, differ = 0, bad = 0, ties = 0;
+    for (int i = 0; i < n; i++) {
+        hits += hc[i].tri >= 0;
+        if (hc[i].tri != hg[i].tri || memcmp(&hc[i].t, &hg[i].t, sizeof(float)) != 0) {
+            if (differ++ < 5)
+                CHECK(0, "%s ray %d: tiles triangle %d t %.9g, grid %d t %.9g", label, i, hc[i].tri,
+                      hc[i].t, hg[i].tri, hg[i].t);
+        }
+        if (i >= nb || hc[i].tri == hb[i].tri) continue;
+        if (hc[i].tri >= 0 && hb[i].tri >= 0 && fabsf(hc[i].t - hb[i].t) <= 1e-5f * hb[i].t)
+            ties++;
+        else if (bad++ < 5)
+            CHECK(0, "%s ray %d: tiles triangle %d t %.9g, brute force %d t %.9g", label, i,
+                  hc[i].tri, hc[i].t, hb[i].tri, hb[i].t);
+    }
+    fprintf(stderr,
+            "    %s: %dx%d tiles; %d camera rays, %d hit, %d differ from the grid; "
+            "%d against brute force: %d ties at equal t, %d mismatches\n",
+            label, ct->nx, ct->ny, n, hits, differ, nb, ties, bad);
+    CHECK(differ == 0 && bad == 0, "%s: %d differ from the grid, %d from brute force", label,
+          differ, bad);
+    CHECK(hits > n / 10, "%s: enough rays hit (%d of %d)", label, hits, n);
+    clReleaseMemObject(mr);
+    clReleaseMemObject(mb);
+    free(rays);
+    free(hc);
+    free(hg);
+    free(hb);
+    fixture_close(&fx);
+}
+
+/* Camera tiles against the grid on 1.05 * 10^6 camera rays (and brute force on 140,000):
+ * cameras outside the scene and inside it (triangles behind the eye and across the plane
+ * through it, which go to every tile), an image whose sides are no multiple of the tile's,
+ * a triangle soup, and a textured prism (textures in contact with their host). */
+static void test_camera_tiles_match_grid(void)
+{
+    static const char *spheres =
+        "{\"image\": {\"width\": 97, \"height\": 61}, \"camera\": %s, " SPHERES_SCENE;
+    static const char *vase =
+        "{\"image\": {\"width\": 120, \"height\": 90}, \"camera\": %s, \"materials\": "
+        "{\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"revolution\", \"segments\": 40, \"material\": \"m\","
+        " \"profile\": [[0, 0], [0.5, 0], [0.8, 0.4], [0.9, 0.9], [0.6, 1.5], [0.3, 2], [0.45, "
+        "2.2]]},"
+        "{\"shape\": \"prism\", \"depth\": 3, \"material\": \"m\", \"transform\": {\"scale\": 2}},"
+        "{\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"m\"}]}";
+    static const char *soup =
+        "{\"image\": {\"width\": 64, \"height\": 64}, \"camera\": %s, \"materials\": "
+        "{\"m\": {}}, \"objects\": ["
+        "{\"shape\": \"mesh\", \"file\": \"soup.obj\", \"material\": \"m\"}]}";
+    static const char *textured =
+        "{\"image\": {\"width\": 100, \"height\": 100}, \"camera\": %s, \"materials\": "
+        "{\"glass\": {\"k_global\": 1, \"eta\": 1.5}, \"s\": {}, \"floor\": {}}, \"objects\": ["
+        "{\"shape\": \"quad\", \"size\": [8, 8], \"material\": \"floor\"},"
+        "{\"shape\": \"prism\", \"depth\": 1.6, \"material\": \"glass\", \"points\": [[-0.9, 0], "
+        "[0.9, 0], [0, 1.5]], \"texture\": {\"generate\": \"bomb --shape sphere --count 30 "
+        "--size 8:18 --seed 4 --level 2\", \"material\": \"s\"}}]}";
+    const struct {
+        const char *label, *json, *camera;
+    } cases[] = {
+        {"spheres, from outside", spheres, "{\"eye\": [0, 0, 9], \"look_at\": [0, 0, 0]}"},
+        {"spheres, from inside the big one", spheres,
+         "{\"eye\": [0.3, 0.2, 1], \"look_at\": [-2, -1, -3], \"fov\": 100}"},
+        {"vase, from above", vase, "{\"eye\": [3, 5, 6], \"look_at\": [0, 0.8, 0]}"},
+        {"vase, eye on the floor", vase,
+         "{\"eye\": [-0.5, 0.05, 3.5], \"look_at\": [0, 0.5, 0], \"fov\": 80}"},
+        {"triangle soup, eye inside", soup, "{\"eye\": [0.1, 0.2, 1.9], \"look_at\": [0, 0, 0]}"},
+        {"textured prism", textured, "{\"eye\": [0.3, 2, 5], \"look_at\": [0, 0.7, 0]}"},
+        {"textured prism, eye inside", textured,
+         "{\"eye\": [0.1, 0.5, 0.3], \"look_at\": [-1, 0.3, -2], \"fov\": 90}"},
+    };
+    write_triangle_soup(400, 99u);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[4096];
+        snprintf(text, sizeof text, cases[i].json, cases[i].camera);
+        compare_camera_tiles(cases[i].label, text, 150000, 20000);
+    }
+    /* render.camera_tiles: false leaves camera rays to the grid; not a boolean: an error */
+    Fixture fx;
+    if (fixture_open(&fx, "{" CAM "\"render\": {\"camera_tiles\": false}, \"materials\": "
+                          "{\"m\": {}}, \"objects\": [{\"shape\": \"box\", "
+                          "\"material\": \"m\"}]}") == 0) {
+        CHECK(fx.r.frame_host.cam_tiles.nx == 0, "camera_tiles false: %d tiles per row",
+              fx.r.frame_host.cam_tiles.nx);
+        fixture_close(&fx);
+    }
+    Scene sc;
+    char err[512];
+    const char *path =
+        tu_write_file("cam_flag.json", "{" CAM "\"render\": {\"camera_tiles\": 1}, \"materials\": "
+                                       "{\"m\": {}}, \"objects\": [{\"shape\": \"box\", "
+                                       "\"material\": \"m\"}]}");
+    CHECK(scene_load(path, &sc, err, sizeof err) != 0 && strstr(err, "render.camera_tiles") &&
+              strstr(err, "expected true or false"),
+          "camera_tiles 1: %s", err);
 }
 
 /* grid_cell_box_range: for random boxes in random top cells (mostly inside the cell, some
@@ -994,6 +1146,7 @@ void suite_kernels(void)
     RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
+    RUN_TEST(test_camera_tiles_match_grid);
     RUN_TEST(test_grid_cell_box_range);
     RUN_TEST(test_contact_opaque_surface_first);
     RUN_TEST(test_light_irradiance_closed_form);

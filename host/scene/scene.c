@@ -272,6 +272,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "subgrid",
                                        "subgrid_density",
                                        "shadow_cone_test",
+                                       "camera_tiles",
                                        "shadow_by_weight",
                                        "penumbra_feelers",
                                        NULL};
@@ -294,6 +295,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->band_layout = DISP_LAYOUT_UNIFORM;
     s->shadow_jitter = 1;
     s->shadow_cone_test = 1;
+    s->camera_tiles = 1;
     s->shadow_by_weight = 1;
     s->penumbra_feelers = SCENE_PENUMBRA_FEELERS;
     if (!j) return 0; /* absent: all defaults */
@@ -317,6 +319,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->seed = (unsigned)seed;
     if (get_bool(c, j, "shadow_jitter", &s->shadow_jitter) ||
         get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||
+        get_bool(c, j, "camera_tiles", &s->camera_tiles) ||
         get_bool(c, j, "shadow_by_weight", &s->shadow_by_weight) ||
         get_choice(c, j, "fresnel", "exact", "thesis", &s->fresnel)) /* SCENE_FRESNEL_* */
         return -1;

@@ -89,6 +89,7 @@ typedef struct Scene {
     unsigned seed;
     int shadow_jitter;    /* render.shadow_jitter: 1 jittered feelers, 0 at stratum centres */
     int shadow_cone_test; /* render.shadow_cone_test: 0 traces every feeler (light_cone_objects) */
+    int camera_tiles;     /* render.camera_tiles: 0 camera rays walk the grid (camera_tiles.h) */
     int shadow_by_weight; /* render.shadow_by_weight: feelers of ray-tree nodes by their weight
                            * (light_node_strata); 0: all shadow_samples at every node */
     int penumbra_feelers; /* render.penumbra_feelers: a point whose first feelers toward a light

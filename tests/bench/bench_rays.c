@@ -5,7 +5,8 @@
  * The scene is loaded and prepared as the renderer does it (scene_load, renderer_init: the
  * same grid for the same --grid), with the probe kernels of kernels/probe.cl, which call the
  * renderer's own device functions. The kinds:
- *   primary     camera rays through the pixel centres: scene_trace_closest / rtcIntersect1
+ *   primary     camera rays through the pixel centres: camera_trace_closest (the camera
+ *               tiles, as the renderer traces them) / rtcIntersect1
  *   shadow      feelers from primary hits on opaque surfaces whose feelers meet no
  *               dielectric: the renderer's light_shade_local at each point / rtcOccluded1
  *   shadow_glass  feelers from the other opaque primary hits (some feeler crosses glass):
@@ -554,10 +555,10 @@ static int vbcl_time(Bench *b, int k, double *ms)
         }
         return 0;
     }
-    int n = (int)kd->nrays;
-    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *vals[] = {&kd->in, &n, &kd->out};
-    return probe_args(b, b->k_closest, 3, sz, vals) || probe_run(b, b->k_closest, kd->nrays, ms)
+    int n = (int)kd->nrays, camera = k == KIND_PRIMARY; /* as the renderer traces them */
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem), sizeof(int)};
+    const void *vals[] = {&kd->in, &n, &kd->out, &camera};
+    return probe_args(b, b->k_closest, 4, sz, vals) || probe_run(b, b->k_closest, kd->nrays, ms)
                ? -1
                : 0;
 }
