@@ -56,8 +56,9 @@ VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, 
 /* Closest hit of a camera ray (org the eye, dir of unit length) within tmax: the triangles
  * of the ray's image tile (host/device/camera_tiles.h), nearest first, until the next quad
  * lies beyond the best hit; the same hit as scene_trace_closest, which rays from elsewhere,
- * or of a frame without tiles, take. The tile is found from dir; the host widened each
- * triangle's tiles by a margin for the rounding of that. */
+ * or of a frame without tiles, take, and so do rays from the eye that leave the image. The
+ * tile is found from dir; the host widened each triangle's tiles by a margin for the
+ * rounding of that. */
 VB_INLINE VbHit camera_trace_closest(const DevScene *sc, float3 org, float3 dir, float tmax,
                                      TraceCount *tc)
 {
@@ -68,6 +69,8 @@ VB_INLINE VbHit camera_trace_closest(const DevScene *sc, float3 org, float3 dir,
         return scene_trace_closest(sc, org, dir, tmax, tc);
     float px = (dot(dir, vb_cload3(ct->right_n)) / a + 1.0f) * (0.5f * (float)f->width);
     float py = (1.0f - dot(dir, vb_cload3(ct->up_n)) / a) * (0.5f * (float)f->height);
+    if (!(px >= 0.0f && px <= (float)f->width && py >= 0.0f && py <= (float)f->height))
+        return scene_trace_closest(sc, org, dir, tmax, tc);
     int tx = clamp(convert_int_sat_rtn(px * (1.0f / VBCL_CAM_TILE)), 0, ct->nx - 1);
     int ty = clamp(convert_int_sat_rtn(py * (1.0f / VBCL_CAM_TILE)), 0, ct->ny - 1);
     uint t = (uint)(ty * ct->nx + tx), end = sc->cam_start[t + 1];

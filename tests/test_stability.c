@@ -51,7 +51,7 @@ static void test_stability_no_leaks_no_self_hits(void)
                       "%s at scale %g%s: %llu of %llu offset rays hit themselves",
                       watertight_shapes[i].name, s, moved ? ", moved" : "", one.self_hits,
                       one.offset_rays);
-                st.aimed += one.aimed, st.leaks += one.leaks;
+                st.aimed += one.aimed, st.leaks += one.leaks, st.camera_aimed += one.camera_aimed;
                 st.brute_aimed += one.brute_aimed, st.brute_leaks += one.brute_leaks;
                 if (one.escapes || one.escapes_out)
                     fprintf(stderr,
@@ -65,11 +65,14 @@ static void test_stability_no_leaks_no_self_hits(void)
             }
     unsigned long long rays = st.aimed + st.brute_aimed + st.offset_rays;
     fprintf(stderr,
-            "    %llu rays: %llu aimed at edges and vertices, %llu leaked (brute force %llu of "
-            "%llu); %llu offset rays, %llu self-hits; %llu targets skipped; %.2f Mrays/s\n",
-            rays, st.aimed, st.leaks, st.brute_leaks, st.brute_aimed, st.offset_rays, st.self_hits,
-            st.skipped, st.seconds > 0 ? rays / st.seconds * 1e-6 : 0.0);
+            "    %llu rays: %llu aimed at edges and vertices (%llu of them camera rays), %llu "
+            "leaked (brute force %llu of %llu); %llu offset rays, %llu self-hits; %llu targets "
+            "skipped; %.2f Mrays/s\n",
+            rays, st.aimed, st.camera_aimed, st.leaks, st.brute_leaks, st.brute_aimed,
+            st.offset_rays, st.self_hits, st.skipped,
+            st.seconds > 0 ? rays / st.seconds * 1e-6 : 0.0);
     CHECK(st.aimed >= 29000, "enough aimed rays (%llu)", st.aimed);
+    CHECK(st.camera_aimed >= 4000, "enough camera rays (%llu)", st.camera_aimed);
 }
 
 /* Renders the scene file to tmp/NAME.exr (frame 0 of an animation) with extra options;

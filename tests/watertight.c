@@ -14,7 +14,8 @@
 #include "render.h"
 #include "scene.h"
 
-#define WT_BATCH 65536 /* targets per device round trip: 2 aimed and 4 offset rays each */
+#define WT_BATCH 65536 /* targets per device round trip */
+#define WT_AIMED 3     /* aimed rays per target at most (and 2 offset rays per hit) */
 
 typedef struct D3 {
     double x, y, z;
@@ -118,6 +119,18 @@ typedef struct Tracer {
     double ms;
 } Tracer;
 
+/* Whether direction d from the eye of frame f passes through its image (a camera ray). */
+static int in_image(const VbFrame *f, D3 d)
+{
+    const VbCamera *c = &f->camera;
+    D3 fw = d3(c->forward[0], c->forward[1], c->forward[2]);
+    D3 r = d3(c->right[0], c->right[1], c->right[2]), u = d3(c->up[0], c->up[1], c->up[2]);
+    double a = d3_dot(d, fw);
+    if (!(a > 0.0)) return 0;
+    double sx = d3_dot(d, r) / (d3_dot(r, r) * a), sy = d3_dot(d, u) / (d3_dot(u, u) * a);
+    return fabs(sx) < 0.999 && fabs(sy) < 0.999;
+}
+
 static void set_ray(VbRay *r, D3 org, D3 dir)
 {
     r->org[0] = (float)org.x, r->org[1] = (float)org.y, r->org[2] = (float)org.z;
@@ -187,18 +200,18 @@ static int tracer_open(Tracer *tr, VbDevice *d, const Scene *s, char *err, size_
                                      &tr->r.frame_host, 0, NULL, NULL);
     cl_int rc2, rc3, rc4, rc5;
     tr->brute = clCreateKernel(tr->r.program, "probe_intersect_brute", &rc2);
-    tr->rays =
-        clCreateBuffer(d->context, CL_MEM_READ_ONLY, sizeof(VbRay) * 4 * WT_BATCH, NULL, &rc3);
-    tr->hits =
-        clCreateBuffer(d->context, CL_MEM_WRITE_ONLY, sizeof(VbHit) * 4 * WT_BATCH, NULL, &rc4);
+    tr->rays = clCreateBuffer(d->context, CL_MEM_READ_ONLY, sizeof(VbRay) * 2 * WT_AIMED * WT_BATCH,
+                              NULL, &rc3);
+    tr->hits = clCreateBuffer(d->context, CL_MEM_WRITE_ONLY,
+                              sizeof(VbHit) * 2 * WT_AIMED * WT_BATCH, NULL, &rc4);
     cl_uint zero[VBCL_COUNTERS] = {0};
     tr->counters = clCreateBuffer(d->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero,
                                   zero, &rc5);
     cl_int rc6, rc7;
-    tr->media =
-        clCreateBuffer(d->context, CL_MEM_READ_WRITE, sizeof(VbMedium) * 4 * WT_BATCH, NULL, &rc6);
-    tr->radiance =
-        clCreateBuffer(d->context, CL_MEM_READ_WRITE, sizeof(float) * 4 * 4 * WT_BATCH, NULL, &rc7);
+    tr->media = clCreateBuffer(d->context, CL_MEM_READ_WRITE,
+                               sizeof(VbMedium) * 2 * WT_AIMED * WT_BATCH, NULL, &rc6);
+    tr->radiance = clCreateBuffer(d->context, CL_MEM_READ_WRITE,
+                                  sizeof(float) * 4 * 2 * WT_AIMED * WT_BATCH, NULL, &rc7);
     rc5 = rc5 ? rc5 : rc6 ? rc6 : rc7;
     if (rc || rc2 || rc3 || rc4 || rc5) {
         snprintf(err, errlen, "setting up the tracer: %s %s %s %s %s", clu_error_name(rc),
@@ -342,11 +355,12 @@ void watertight_scene_json(const char *object, double scale, const double offset
                            size_t n)
 {
     snprintf(out, n,
-             "{\"camera\": {\"eye\": [0, 0, 10], \"look_at\": [0, 0, 0]},\n"
+             "{\"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"look_at\": [%.9g, %.9g, %.9g]},\n"
              " \"materials\": {\"m\": {}},\n"
              " \"objects\": [{%s, \"material\": \"m\",\n"
              "   \"transform\": {\"scale\": %.9g, \"rotate\": [17, 29, 41],"
              " \"translate\": [%.9g, %.9g, %.9g]}}]}\n",
+             offset[0], offset[1], offset[2] + 10.0 * scale, offset[0], offset[1], offset[2],
              object, scale, offset[0], offset[1], offset[2]);
 }
 
@@ -417,15 +431,15 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
     if (scene_load(scene_path, &s, err, errlen)) return -1;
     const Mesh *m = &s.mesh;
     char cerr[512];
-    VbRay *rays = malloc(sizeof *rays * 2 * WT_BATCH);
-    VbRay *brays = malloc(sizeof *brays * 2 * WT_BATCH);
-    VbRay *orays = malloc(sizeof *orays * 4 * WT_BATCH);
-    VbHit *hits = malloc(sizeof *hits * 4 * WT_BATCH);
-    VbHit *bhits = malloc(sizeof *bhits * 2 * WT_BATCH);
-    Aim *aim = malloc(sizeof *aim * 2 * WT_BATCH);
-    Aim *baim = malloc(sizeof *baim * 2 * WT_BATCH);
-    int *src = malloc(sizeof *src * 4 * WT_BATCH),
-        *outside = malloc(sizeof *outside * 4 * WT_BATCH);
+    VbRay *rays = malloc(sizeof *rays * WT_AIMED * WT_BATCH);
+    VbRay *brays = malloc(sizeof *brays * WT_AIMED * WT_BATCH);
+    VbRay *orays = malloc(sizeof *orays * 2 * WT_AIMED * WT_BATCH);
+    VbHit *hits = malloc(sizeof *hits * 2 * WT_AIMED * WT_BATCH);
+    VbHit *bhits = malloc(sizeof *bhits * WT_AIMED * WT_BATCH);
+    Aim *aim = malloc(sizeof *aim * WT_AIMED * WT_BATCH);
+    Aim *baim = malloc(sizeof *baim * WT_AIMED * WT_BATCH);
+    int *src = malloc(sizeof *src * 2 * WT_AIMED * WT_BATCH),
+        *outside = malloc(sizeof *outside * 2 * WT_AIMED * WT_BATCH);
     D3 *normals = malloc(sizeof *normals * ((size_t)m->ntris + 1));
     if (!rays || !brays || !orays || !hits || !bhits || !aim || !baim || !src || !outside ||
         !normals || adjacency_build(&adj, m)) {
@@ -447,6 +461,10 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
     mesh_bounds(m, &lo, &hi);
     D3 ext = d3_sub(d3_of(hi), d3_of(lo));
     double extent = sqrt(d3_dot(ext, ext));
+    const float *ce = tr.r.frame_host.camera.eye;
+    D3 eye = d3(ce[0], ce[1], ce[2]);
+    int eye_out = eye.x < lo.x || eye.x > hi.x || eye.y < lo.y || eye.y > hi.y || eye.z < lo.z ||
+                  eye.z > hi.z;
     uint64_t rng = 0x9e3779b97f4a7c15ull ^ ((uint64_t)seed << 17);
     for (long done_targets = 0; done_targets < targets;) {
         long nb = targets - done_targets < WT_BATCH ? targets - done_targets : WT_BATCH;
@@ -465,17 +483,30 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
             /* the inside origin must lie clearly before p in float, else only the ray
              * from outside is fired */
             double back = 0.25 * fmin(edge, extent);
-            int nrays = back >= 1024 * FLT_EPSILON * (d3_maxabs(p) + extent) ? 2 : 1;
-            st->skipped += (unsigned long long)(2 - nrays);
-            D3 o_in = d3_sub(p, d3_mul(dout, back));
-            D3 org[2] = {o_far, o_in}, dir[2] = {din, dout};
+            int inner = back >= 1024 * FLT_EPSILON * (d3_maxabs(p) + extent);
+            st->skipped += (unsigned long long)!inner;
+            D3 org[3] = {o_far}, dir[3] = {din};
+            int outer[3] = {1}, nrays = 1;
+            if (inner) {
+                org[nrays] = d3_sub(p, d3_mul(dout, back)), dir[nrays] = dout;
+                outer[nrays++] = 0;
+            }
+            /* a camera ray, where it crosses the surface at p as cleanly as the others */
+            D3 to_p = d3_norm(d3_sub(p, eye));
+            int clean = eye_out && in_image(&tr.r.frame_host, to_p);
+            for (int f = 0; f < k && clean; f++) clean = d3_dot(to_p, nrm[f]) <= -0.1;
+            if (clean) {
+                org[nrays] = eye, dir[nrays] = to_p;
+                outer[nrays++] = 2;
+            }
             for (int j = 0; j < nrays; j++) {
                 set_ray(&rays[n], org[j], dir[j]);
                 D3 of = d3(rays[n].org[0], rays[n].org[1], rays[n].org[2]);
                 D3 df = d3(rays[n].dir[0], rays[n].dir[1], rays[n].dir[2]);
                 aim[n].t_aim = d3_dot(d3_sub(p, of), df) / d3_dot(df, df);
                 aim[n].tol = 1e-4 * (d3_maxabs(of) + d3_maxabs(p) + aim[n].t_aim);
-                aim[n].outside = j == 0;
+                aim[n].outside = outer[j] != 0;
+                st->camera_aimed += outer[j] == 2;
                 if (brute_every > 0 && (done_targets + i) % brute_every == 0) {
                     brays[nbrute] = rays[n];
                     baim[nbrute++] = aim[n];

@@ -10,10 +10,13 @@
 
 /* Counts over one or more runs; watertight_run adds to them. */
 typedef struct WtStats {
-    unsigned long long aimed;       /* rays aimed at an edge or vertex point (grid kernel) */
-    unsigned long long leaks;       /* of those: no hit, a first hit past the aimed point, or
-                                       (from outside) a first hit on a back face */
-    unsigned long long brute_aimed; /* the same rays traced by probe_intersect_brute */
+    unsigned long long aimed;        /* rays aimed at an edge or vertex point (the renderer's
+                                        scene_intersect_closest) */
+    unsigned long long camera_aimed; /* of those: from the camera's eye, through the image (its
+                                       camera tiles, camera_trace_closest) */
+    unsigned long long leaks;        /* of those: no hit, a first hit past the aimed point, or
+                                        (from outside) a first hit on a back face */
+    unsigned long long brute_aimed;  /* the same rays traced by probe_intersect_brute */
     unsigned long long brute_leaks;
     unsigned long long offset_rays; /* rays leaving hit points from the offset origin */
     unsigned long long self_hits;   /* of those: hits on the own triangle, or on a neighbour
@@ -42,13 +45,15 @@ extern const int watertight_nshapes;
 
 /* Writes a scene holding one object (object: the JSON of its shape keys, without the
  * material, e.g. "\"shape\": \"sphere\", \"level\": 3") scaled by `scale` and translated
- * by offset, into out. */
+ * by offset, seen from 10 * scale along z, into out. */
 void watertight_scene_json(const char *object, double scale, const double offset[3], char *out,
                            size_t n);
 
 /* Loads the scene at scene_path (its mesh must be closed), prepares it on d with the test
  * kernels and fires `targets` aimed points' worth of rays at it: per target one ray from
- * far outside and one from just inside, each crossing the surface at the point, and per
+ * far outside and one from just inside, each crossing the surface at the point, one from the
+ * camera's eye where the eye lies outside the mesh's bounds and the point in the image (a
+ * camera ray, traced through the camera tiles), and per
  * hit two rays leaving it from the offset origin (along the normal and in a random
  * direction, back into the side the ray came from). The self-hit distance is 1e-3 times
  * the mesh's bounding-box diagonal; convex: the mesh is convex, so an outward ray must hit

@@ -58,6 +58,7 @@ static void run_case(VbDevice *d, const char *name, const char *object, int conv
     fflush(stdout);
     WtStats *t = &tot->st;
     t->aimed += one.aimed, t->leaks += one.leaks, t->brute_aimed += one.brute_aimed;
+    t->camera_aimed += one.camera_aimed;
     t->brute_leaks += one.brute_leaks, t->offset_rays += one.offset_rays;
     t->self_hits += one.self_hits, t->escapes += one.escapes, t->escapes_out += one.escapes_out;
     t->skipped += one.skipped, t->seconds += one.seconds;
@@ -167,8 +168,9 @@ int main(int argc, char **argv)
            "%.2f Mrays/s with the host checks)\n",
            tot.cases, nmeshes, rays, wall, s->seconds > 0 ? rays / s->seconds * 1e-6 : 0.0,
            rays / wall * 1e-6);
-    printf("leaks: %llu of %llu aimed rays (brute force: %llu of %llu); %llu targets skipped\n",
-           s->leaks, s->aimed, s->brute_leaks, s->brute_aimed, s->skipped);
+    printf("leaks: %llu of %llu aimed rays, %llu of them camera rays (brute force: %llu of %llu); "
+           "%llu targets skipped\n",
+           s->leaks, s->aimed, s->camera_aimed, s->brute_leaks, s->brute_aimed, s->skipped);
     printf("self-hits: %llu of %llu offset rays; origins in the wrong medium: %llu leaving "
            "inward, %llu outward\n",
            s->self_hits, s->offset_rays, s->escapes, s->escapes_out);
