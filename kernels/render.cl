@@ -112,8 +112,8 @@ __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
 }
 
 /* rays -> hits, media: the closest interface of each camera ray (camera_trace_closest: its
- * image tile's triangles, or the grid), and the
- * medium the ray is in just before it (rays start in the camera's medium). */
+ * image tile's triangles, or the grid), and the medium the ray is in just before it (rays
+ * start in the camera's medium). */
 __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);

@@ -53,7 +53,7 @@ VB_INLINE VbHit scene_trace_closest(const DevScene *sc, float3 org, float3 dir, 
                               sc->leaf_quads, org, dir, tmax, tc);
 }
 
-/* Closest hit of a camera ray (org the eye, dir of unit length) within tmax: the triangles
+/* Closest hit of a camera ray (org the eye) within tmax: the triangles
  * of the ray's image tile (host/device/camera_tiles.h), nearest first, until the next quad
  * lies beyond the best hit; the same hit as scene_trace_closest, which rays from elsewhere,
  * or of a frame without tiles, take, and so do rays from the eye that leave the image. The
@@ -78,8 +78,9 @@ VB_INLINE VbHit camera_trace_closest(const DevScene *sc, float3 org, float3 dir,
     closest_begin(&c, tmax);
     RayShear rs = ray_shear_make(org, dir);
     uint tests = 0;
-    /* a hit at t lies t * |dir| from the eye, |dir| = 1 within rounding: 1e-4 is ample */
-    for (uint k = sc->cam_start[t]; k < end && sc->cam_near[k] <= c.reach * 1.0001f; k++)
+    /* a hit at t lies t |dir| from the eye (1e-4 more is ample for the rounding) */
+    float reach_scale = length(dir) * 1.0001f;
+    for (uint k = sc->cam_start[t]; k < end && sc->cam_near[k] <= c.reach * reach_scale; k++)
         tests += quad_closest(&rs, org, tmax, sc->tris, sc->cam_quads + k, &c);
     tc->steps++;
     tc->tests += tests;
