@@ -253,10 +253,56 @@ static int upload_patterns(SceneBuffers *b, VbDevice *dev, const Scene *s, unsig
     return rc;
 }
 
-/* Triangles, smooth normals (with VBCL_FEATURE_SMOOTH_NORMALS) and grid cells. Returns 0,
- * 1 (out of memory, device) or 2 (larger than one allocation). */
+/* The camera tiles of s (camera_tiles.h), from its packed triangles, into b and ct, or none (ct->nx
+ * = 0, buffers of one element) where s turns them off or they would take more than 64 references
+ * per triangle and per tile, CAM_TILES_MAX_REFS in all (about 100 MB), or one allocation. Returns 0
+ * or 1 (out of memory, device). */
+#define CAM_TILES_MAX_REFS ((size_t)1 << 21)
+static int upload_camera_tiles(SceneBuffers *b, VbDevice *dev, const Scene *s,
+                               const VbTriangle *tris, VbCamTiles *ct, char *err, size_t errlen)
+{
+    CamTiles t;
+    memset(&t, 0, sizeof t);
+    memset(ct, 0, sizeof *ct);
+    VbCamera cam;
+    frame_camera(s, &cam);
+    size_t ntiles = (size_t)((s->width + VBCL_CAM_TILE - 1) / VBCL_CAM_TILE) *
+                    (size_t)((s->height + VBCL_CAM_TILE - 1) / VBCL_CAM_TILE);
+    size_t cap = 64 * ((size_t)s->mesh.ntris + ntiles), fit = dev->max_alloc / sizeof(VbLeafQuad);
+    cap = cap < CAM_TILES_MAX_REFS ? cap : CAM_TILES_MAX_REFS;
+    if (s->camera_tiles &&
+        camtiles_build(&t, &cam, s->width, s->height, tris, s->mesh.ntris, cap < fit ? cap : fit)) {
+        snprintf(err, errlen, "out of memory sorting %u triangles into camera tiles",
+                 s->mesh.ntris);
+        return 1;
+    }
+    size_t nstart = t.nx ? (size_t)t.nx * (size_t)t.ny + 1 : 0;
+    b->cam_start = clu_buffer(dev, t.start, sizeof(uint32_t) * nstart, CL_MEM_READ_ONLY);
+    b->cam_quads = clu_buffer(dev, t.quads, sizeof(VbLeafQuad) * t.nquads, CL_MEM_READ_ONLY);
+    b->cam_near = clu_buffer(dev, t.near, sizeof(float) * t.nquads, CL_MEM_READ_ONLY);
+    if (t.nx) {
+        double r2 = 0.0, u2 = 0.0;
+        for (int a = 0; a < 3; a++) {
+            r2 += (double)cam.right[a] * cam.right[a];
+            u2 += (double)cam.up[a] * cam.up[a];
+        }
+        for (int a = 0; a < 3; a++) {
+            ct->right_n[a] = (float)(cam.right[a] / r2);
+            ct->up_n[a] = (float)(cam.up[a] / u2);
+        }
+        ct->nx = t.nx;
+        ct->ny = t.ny;
+    }
+    camtiles_free(&t);
+    if (b->cam_start && b->cam_quads && b->cam_near) return 0;
+    snprintf(err, errlen, "%s: %s", dev->name, clu_error());
+    return 1;
+}
+
+/* Triangles, smooth normals (with VBCL_FEATURE_SMOOTH_NORMALS), grid cells and the camera
+ * tiles (into ct). Returns 0, 1 (out of memory, device) or 2 (larger than one allocation). */
 static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const Grid *g,
-                           unsigned features, char *err, size_t errlen)
+                           unsigned features, VbCamTiles *ct, char *err, size_t errlen)
 {
     size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
     if (nbytes_tris > dev->max_alloc ||
@@ -282,6 +328,7 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
         return 1;
     }
     b->tris = clu_buffer(dev, tris, nbytes_tris, CL_MEM_READ_ONLY);
+    int rc = upload_camera_tiles(b, dev, s, tris, ct, err, errlen);
     b->normals = clu_buffer(
         dev, normals,
         (features & VBCL_FEATURE_SMOOTH_NORMALS) ? sizeof(VbTriNormals) * s->mesh.ntris : 0,
@@ -294,56 +341,8 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
     b->leaf_quads = clu_buffer(dev, quads, sizeof(VbLeafQuad) * nquads, CL_MEM_READ_ONLY);
     free(quad_start);
     free(quads);
+    if (rc) return rc;
     if (b->tris && b->normals && b->grid_cells && b->leaf_start && b->leaf_quads) return 0;
-    snprintf(err, errlen, "%s: %s", dev->name, clu_error());
-    return 1;
-}
-
-/* The camera tiles of s (camera_tiles.h) into b and ct, or none (ct->nx = 0, buffers of
- * one element) where s turns them off or they would take more than 64 references per
- * triangle and per tile, CAM_TILES_MAX_REFS in all (about 100 MB), or one allocation.
- * Returns 0 or 1 (out of memory, device). */
-#define CAM_TILES_MAX_REFS ((size_t)1 << 21)
-static int upload_camera_tiles(SceneBuffers *b, VbDevice *dev, const Scene *s, VbCamTiles *ct,
-                               char *err, size_t errlen)
-{
-    CamTiles t;
-    memset(&t, 0, sizeof t);
-    memset(ct, 0, sizeof *ct);
-    VbCamera cam;
-    frame_camera(s, &cam);
-    VbTriangle *tris = s->camera_tiles ? pack_triangles(s) : NULL;
-    size_t ntiles = (size_t)((s->width + VBCL_CAM_TILE - 1) / VBCL_CAM_TILE) *
-                    (size_t)((s->height + VBCL_CAM_TILE - 1) / VBCL_CAM_TILE);
-    size_t cap = 64 * ((size_t)s->mesh.ntris + ntiles), fit = dev->max_alloc / sizeof(VbLeafQuad);
-    cap = cap < CAM_TILES_MAX_REFS ? cap : CAM_TILES_MAX_REFS;
-    if (s->camera_tiles && (!tris || camtiles_build(&t, &cam, s->width, s->height, tris,
-                                                    s->mesh.ntris, cap < fit ? cap : fit))) {
-        free(tris);
-        snprintf(err, errlen, "out of memory sorting %u triangles into camera tiles",
-                 s->mesh.ntris);
-        return 1;
-    }
-    free(tris);
-    size_t nstart = t.nx ? (size_t)t.nx * (size_t)t.ny + 1 : 0;
-    b->cam_start = clu_buffer(dev, t.start, sizeof(uint32_t) * nstart, CL_MEM_READ_ONLY);
-    b->cam_quads = clu_buffer(dev, t.quads, sizeof(VbLeafQuad) * t.nquads, CL_MEM_READ_ONLY);
-    b->cam_near = clu_buffer(dev, t.near, sizeof(float) * t.nquads, CL_MEM_READ_ONLY);
-    if (t.nx) {
-        double r2 = 0.0, u2 = 0.0;
-        for (int a = 0; a < 3; a++) {
-            r2 += (double)cam.right[a] * cam.right[a];
-            u2 += (double)cam.up[a] * cam.up[a];
-        }
-        for (int a = 0; a < 3; a++) {
-            ct->right_n[a] = (float)(cam.right[a] / r2);
-            ct->up_n[a] = (float)(cam.up[a] / u2);
-        }
-        ct->nx = t.nx;
-        ct->ny = t.ny;
-    }
-    camtiles_free(&t);
-    if (b->cam_start && b->cam_quads && b->cam_near) return 0;
     snprintf(err, errlen, "%s: %s", dev->name, clu_error());
     return 1;
 }
@@ -760,8 +759,7 @@ int scene_buffers_upload(SceneBuffers *b, VbDevice *dev, const Scene *s, const G
     memset(b, 0, sizeof *b);
     unsigned band_weights = 0;
     VbCamTiles ct;
-    int rc = upload_geometry(b, dev, s, g, features, err, errlen);
-    if (!rc) rc = upload_camera_tiles(b, dev, s, &ct, err, errlen);
+    int rc = upload_geometry(b, dev, s, g, features, &ct, err, errlen);
     if (!rc) rc = upload_materials(b, dev, s, features, &band_weights, err, errlen);
     if (rc) return rc;
     frame_fill(s, g, band_weights, f);
