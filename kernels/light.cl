@@ -299,8 +299,9 @@ VB_INLINE float3 light_feeler_decided(const DevScene *scn, const ShadePoint *sp,
                                       const ObjectSet *os, float3 origin, float3 w, float t,
                                       int tex_free, TraceCount *tc, ShadowCount *sc)
 {
-    int need = os->n >= 0 && os->nbig > 0 ? object_set_feeler(scn, os, origin, w, t, tex_free)
-                                          : (os->n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
+    int need = os->n >= 0 && os->nbig > 0
+                   ? object_set_feeler(scn, os, origin, w, t, tex_free, sp->medium.host)
+                   : (os->n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
     if (need == OBJECT_SET_BLOCKED) {
         sc->blocked++;
         return (float3)(0.0f);

@@ -134,7 +134,9 @@ VB_INLINE int probe_blocked_feeler(const DevScene *sc, const ShadePoint *sp, con
 /* For probe_cone_brute: the closest hit of the feeler (org, w, t) among all triangles but
  * those of os's big parts, into *all; returns a big part's triangle the feeler meets
  * inside its host (by more than 1e-4 of the scene's size; outside, a part's surface
- * changes nothing), or 0xffffffff. */
+ * changes nothing), or 0xffffffff. A texture triangle met outside the sphere of its host's
+ * own triangles (VbObject.own, whose radius has the host's margins) is left out too: it
+ * lies outside the host, where it changes nothing. */
 VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, float3 org, float3 w,
                                     float t, Closest *all)
 {
@@ -146,6 +148,17 @@ VB_INLINE uint probe_feeler_closest(const DevScene *sc, const ObjectSet *os, flo
             __global const VbObject *el = sc->objects + os->big[k];
             if (os->big[k] >= sc->f->nobjects && q - el->first_tri < el->ntris)
                 part = (int)os->big[k];
+        }
+        uint tag = tri_tag(sc->tris, (int)q);
+        if (part < 0 && (tag & VBCL_TAG_TEXTURE)) {
+            float th, uh, vh;
+            if (!tri_intersect(&rs, tri_vertex(sc->tris, (int)q, 0),
+                               tri_vertex(sc->tris, (int)q, 1), tri_vertex(sc->tris, (int)q, 2), t,
+                               &th, &uh, &vh))
+                continue;
+            float3 p = org + th * w;
+            float4 own = vload4(0, sc->objects[tag & ~VBCL_TAG_FLAGS].own);
+            if (length(p - own.xyz) > own.w) continue; /* own.w has the host's margins */
         }
         if (part < 0) {
             closest_test(&rs, org, t, sc->tris, (int)q, all);
@@ -220,15 +233,17 @@ VB_INLINE float3 probe_cap_feeler(const ProbeCap *cap, int i, int k)
  * cone) has big objects or texture parts whose bounds each feeler tests, bit 3 where some feeler
  * met such bounds (and walks the grid where it lies in them), bit 4 where some feeler passed
  * through a solid part's core (not traced in a render: its walk through the grid, run here, must
- * let nothing through), bits 5-15 how many of nrays feelers spread over the light's cap (uniform in
- * solid angle, 8 on its rim; those leaving the surface's front only, each to the near side of the
- * sphere) the brute force (or for the blocked ones, the walk) contradicts: for a clear cone,
- * feelers that meet a triangle, every triangle tested; for a set, feelers whose closest hit among
- * the set's triangles (scene_trace_closest_in) is not the closest of all triangles (the same test,
- * ties to the lower index; the big parts' left out, but a feeler that meets one inside its host is
- * wrong), and for a feeler that meets a big record's bounds, one whose closest or any hit through
- * the set and the grid over object_set_span differs from the whole walk's (bit for bit), bits 16-31
- * such a feeler's triangle (clear) or its hit + 1 (set). */
+ * let nothing through), bit 5 where some feeler that starts outside a host met the bounds of the
+ * host with its texture but not the sphere of its own triangles (VbObject.own: object_set_feeler
+ * leaves the host out for it), bits 6-15 how many of nrays feelers spread over the light's cap
+ * (uniform in solid angle, 8 on its rim; those leaving the surface's front only, each to the near
+ * side of the sphere) the brute force (or for the blocked ones, the walk) contradicts: for a clear
+ * cone, feelers that meet a triangle, every triangle tested; for a set, feelers whose closest hit
+ * among the set's triangles (scene_trace_closest_in) is not the closest of all triangles (the same
+ * test, ties to the lower index; the big parts' left out, but a feeler that meets one inside its
+ * host is wrong), and for a feeler that meets a big record's bounds, one whose closest or any hit
+ * through the set and the grid over object_set_span differs from the whole walk's (bit for bit),
+ * bits 16-31 such a feeler's triangle (clear) or its hit + 1 (set). */
 __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, int ncases, int nrays,
                                __global uint *out)
 {
@@ -247,15 +262,23 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
     ObjectSet os;
     light_cone_objects(&sc, &sp, &ls, r, &os);
     uint kind = os.n == 0 ? 1u : os.n > 0 ? 2u : 0u;
-    uint wrong = 0u, which = 0u, big = 0u, blocked = 0u;
+    uint wrong = 0u, which = 0u, big = 0u, blocked = 0u, shell = 0u;
     if (kind != 0u) {
         ProbeCap cap = probe_cap_make(&ls, r);
         for (int k = 0; k < nrays; k++) {
             float3 w = probe_cap_feeler(&cap, i, k);
             if (dot(sp.ng, w) <= 0.0f) continue;
             float t_light = light_sphere_near(&ls, w, r);
+            for (uint o = 0; o < sc.f->nobjects; o++) {
+                __global const VbObject *ho = sc.objects + o;
+                float2 c = sphere_chord(vload4(0, ho->own), ls.origin, w, t_light);
+                if ((ho->flags & VBCL_OBJECT_HOST) && sp.medium.host != (int)o &&
+                    object_segment_meets(ho, ls.origin, w, t_light) &&
+                    !(c.x <= t_light && c.y >= 0.0f))
+                    shell = 1u;
+            }
             int need = os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
-                                                       sp.medium.tex_counts == 0u)
+                                                       sp.medium.tex_counts == 0u, sp.medium.host)
                                    : OBJECT_SET_ALONE;
             if (need == OBJECT_SET_GRID) {
                 /* this feeler walks the grid where it lies in the big records' bounds, as a
@@ -301,7 +324,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
         }
     }
     out[i] = kind | (kind != 0u && os.nbig > 0 ? 4u : 0u) | (big > 0u ? 8u : 0u) |
-             (blocked > 0u ? 16u : 0u) | min(wrong, 2047u) << 5 | which << 16;
+             (blocked > 0u ? 16u : 0u) | shell << 5 | min(wrong, 1023u) << 6 | which << 16;
 }
 
 #ifdef VBCL_HAS_TRANSPARENCY
@@ -371,9 +394,10 @@ __kernel void probe_sole_exit(SCENE_KERNEL_ARGS __global const float *cases, int
         float3 w = probe_cap_feeler(&cap, i, k);
         if (dot(sp.ng, w) <= 0.0f) continue;
         float t_light = light_sphere_near(&ls, w, r);
-        int need = os.n >= 0 && os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
-                                                                sp.medium.tex_counts == 0u)
-                                            : (os.n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
+        int need = os.n >= 0 && os.nbig > 0
+                       ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
+                                           sp.medium.tex_counts == 0u, sp.medium.host)
+                       : (os.n < 0 ? OBJECT_SET_GRID : OBJECT_SET_ALONE);
         if (need == OBJECT_SET_BLOCKED || (need == OBJECT_SET_ALONE && os.n == 0)) continue;
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0, 0, 0, 0, 0};

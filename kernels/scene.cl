@@ -117,12 +117,12 @@ typedef struct ObjectSet {
                * their bounding spheres (object_set_span); 0: the ranges alone */
 } ObjectSet;
 
-/* Where the line from org along the unit dir lies in the bounding sphere of record ob,
- * widened by margins as the cone test's (1e-5 of the distances, reach the farthest one
- * along the line that matters): (in, out), or (inf, -inf) where it misses the sphere. */
-VB_INLINE float2 object_chord(__global const VbObject *ob, float3 org, float3 dir, float reach)
+/* Where the line from org along the unit dir lies in sphere b (centre, radius; radius < 0:
+ * none), widened by margins as the cone test's (1e-5 of the distances, reach the farthest
+ * one along the line that matters): (in, out), or (inf, -inf) where it misses the sphere. */
+VB_INLINE float2 sphere_chord(float4 b, float3 org, float3 dir, float reach)
 {
-    float4 b = vload4(0, ob->bound);
+    if (b.w < 0.0f) return (float2)(INFINITY, -INFINITY);
     float3 v = b.xyz - org;
     float along = dot(v, dir);
     float3 q = v - along * dir;
@@ -131,6 +131,12 @@ VB_INLINE float2 object_chord(__global const VbObject *ob, float3 org, float3 di
     if (h2 < 0.0f) return (float2)(INFINITY, -INFINITY);
     float h = sqrt(h2);
     return (float2)(along - h, along + h);
+}
+
+/* sphere_chord of record ob's bounding sphere. */
+VB_INLINE float2 object_chord(__global const VbObject *ob, float3 org, float3 dir, float reach)
+{
+    return sphere_chord(vload4(0, ob->bound), org, dir, reach);
 }
 
 /* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
@@ -184,14 +190,14 @@ VB_INLINE int object_segment_through_core(__global const VbObject *ob, float3 or
 /* The stretch [s0, s1] of the segment from org along the unit dir to distance t that lies
  * inside the convex host ob (VBCL_OBJECT_HULL), each plane of its triangles clipping it,
  * widened by margin m at both ends; s0 > s1 where it misses the host. A host of more than
- * VB_HULL_PLANES triangles gives the stretch in its bounding sphere instead, which holds
- * the one inside it. */
+ * VB_HULL_PLANES triangles gives the stretch in the sphere of its own triangles instead
+ * (VbObject.own, its texture left out), which holds the one inside it. */
 #define VB_HULL_PLANES 64
 VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject *ob, float3 org,
                                      float3 dir, float t, float m)
 {
     if (ob->ntris > VB_HULL_PLANES) {
-        float2 c = object_chord(ob, org, dir, t);
+        float2 c = sphere_chord(vload4(0, ob->own), org, dir, t);
         return (float2)(fmax(c.x, 0.0f) - m, fmin(c.y, t) + m);
     }
     float s0 = 0.0f, s1 = t;
@@ -215,10 +221,14 @@ VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject
  * OBJECT_SET_GRID, the grid (it meets the bounds of one of the set's big objects or parts);
  * OBJECT_SET_BLOCKED, nothing: it passes through the core of a solid big part
  * (VBCL_OBJECT_SOLID) and is stopped there, whatever it crosses before (with transparency,
- * where the feeler starts outside every texture element: tex_free). */
+ * where the feeler starts outside every texture element: tex_free). start_host: the host
+ * the feeler starts in (VbMedium.host). A big host that the feeler starts outside needs it
+ * only where the feeler meets the sphere of the host's own triangles (VbObject.own): one
+ * that never enters the host crosses none of its own triangles, and its texture's
+ * surfaces outside the host change no material (medium_cross), so they stop nothing. */
 enum { OBJECT_SET_ALONE = 0, OBJECT_SET_GRID = 1, OBJECT_SET_BLOCKED = 2 };
 VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
-                                float t, int tex_free)
+                                float t, int tex_free, int start_host)
 {
     int need = OBJECT_SET_ALONE;
     uint host = 0xffffffffu; /* whose stretch st is */
@@ -226,7 +236,13 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
     for (int k = 0; k < os->nbig; k++) {
         __global const VbObject *ob = sc->objects + os->big[k];
         if (!object_segment_meets(ob, org, dir, t)) continue;
-        if (os->big[k] < sc->f->nobjects) return OBJECT_SET_GRID; /* an object, not a part */
+        if (os->big[k] < sc->f->nobjects) { /* an object, not a part */
+            if ((ob->flags & VBCL_OBJECT_HOST) && start_host != (int)os->big[k]) {
+                float2 c = sphere_chord(vload4(0, ob->own), org, dir, t);
+                if (!(c.x <= t && c.y >= 0.0f)) continue;
+            }
+            return OBJECT_SET_GRID;
+        }
 #ifdef VBCL_HAS_TRANSPARENCY
         if (tex_free && (ob->flags & VBCL_OBJECT_SOLID) &&
             object_segment_through_core(ob, org, dir, t))

@@ -170,6 +170,9 @@ typedef struct VbObject {
                               * and the range (first_tri, ntris) of one part of the texture;
                               * nelems 0: the texture is bounded as a whole */
     unsigned int nelems;
+    float own[4]; /* a sphere holding the object's own triangles alone, its texture left out
+                   * (as bound: centre, radius with margins; radius < 0: none); a part's and a
+                   * textureless object's is bound */
     unsigned int pad2[2];
 } VbObject;
 
@@ -338,7 +341,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
-    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -377,7 +380,8 @@ VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
 VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
-VBCL_STATIC_ASSERT(sizeof(VbObject) == 112, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 128, object_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, own) == 104, object_own);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, nelems) == 100, object_nelems);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, first_tri) == 80, object_first_tri);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ntex) == 92, object_ntex);

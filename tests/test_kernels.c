@@ -699,7 +699,13 @@ static unsigned *run_cone_probe(Fixture *fx, const char *kernel, int ncases, int
  * sets must also come from points on the texture's spheres (the prism's triangles without
  * the spheres the cone misses). Feelers that pass through the core of a solid sphere,
  * which a render does not trace, must meet that sphere and, where the probe knows their
- * medium, be stopped by the walk through the grid. */
+ * medium, be stopped by the walk through the grid. A glass ball of 320 triangles holds a
+ * texture of bombed spheres, many of them reaching out of it or lying wholly outside: a
+ * feeler from outside it that meets the bounds of the ball with its texture but not the
+ * sphere of the ball's own triangles (VbObject.own) keeps off the grid, and must still get
+ * every hit that matters (texture triangles met outside that sphere change nothing); over
+ * 1% of the points have such feelers. Its teeth: with that sphere 3% too small, 71 clear
+ * cones and 33 sets are wrong. */
 static void test_light_cone_brute(void)
 {
     Fixture fx;
@@ -724,7 +730,10 @@ static void test_light_cone_brute(void)
             " \"material\": \"g\", \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, "
             "0.05, 2]},"
             " \"texture\": {\"generate\": \"bomb --shape sphere --count 6 --size 20:30 --seed 3\","
-            " \"material\": \"e\"}}]}"))
+            " \"material\": \"e\"}},"
+            "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.7, \"centre\": [2.5, 1.2, -2.5],"
+            " \"material\": \"g\", \"texture\": {\"generate\": \"bomb --shape sphere --count 12 "
+            "--size 14:24 --seed 8 --level 1\", \"material\": \"e\"}}]}"))
         return;
     enum { CASES = 16384, RAYS = 128 };
     const Mesh *m = &fx.s.mesh;
@@ -736,12 +745,13 @@ static void test_light_cone_brute(void)
         return;
     }
     long count[4] = {0, 0, 0, 0}, wrong[4] = {0, 0, 0, 0}, own_clear = 0, tex_sets = 0;
-    long big_sets = 0, big_met = 0, blocked = 0;
+    long big_sets = 0, big_met = 0, blocked = 0, shell = 0;
     for (int i = 0; i < CASES; i++) {
-        unsigned kind = out[i] & 3u, nb = (out[i] >> 5) & 2047u;
+        unsigned kind = out[i] & 3u, nb = (out[i] >> 6) & 1023u;
         big_sets += (out[i] & 4u) != 0;
         big_met += (out[i] & 8u) != 0;
         blocked += (out[i] & 16u) != 0;
+        shell += kind != 0 && (out[i] & 32u) != 0;
         count[kind]++;
         wrong[kind] += nb != 0;
         int obj = (int)cases[16 * i + 3];
@@ -761,17 +771,19 @@ static void test_light_cone_brute(void)
             "their own surface left out), %ld a set of objects alone, %ld the grid, %ld inside "
             "a light (%ld sets from points on the texture's spheres; %ld with spheres whose "
             "bounds each feeler tests, %ld with feelers that meet them, %ld with feelers through "
-            "a solid sphere's core); %ld feelers against brute force\n",
+            "a solid sphere's core, %ld with feelers beside a host that meet its texture's "
+            "bounds); %ld feelers against brute force\n",
             m->ntris, CASES, count[1], own_clear, count[2], count[0], count[3], tex_sets, big_sets,
-            big_met, blocked, (count[1] + count[2]) * RAYS);
+            big_met, blocked, shell, (count[1] + count[2]) * RAYS);
     CHECK(wrong[1] == 0, "%ld clear cones have feelers that meet a triangle", wrong[1]);
     CHECK(wrong[2] == 0, "%ld cones' object sets miss a feeler's closest hit", wrong[2]);
     CHECK((count[1] + count[2]) * RAYS >= 1000000 && own_clear > count[1] / 4 &&
               count[2] > CASES / 20 && tex_sets > CASES / 100 && big_sets > CASES / 100 &&
-              big_met > 0 && big_met < big_sets && blocked > CASES / 200,
+              big_met > 0 && big_met < big_sets && blocked > CASES / 200 && shell > CASES / 100,
           "too few cones to test: %ld clear (%ld on planar or convex objects), %ld sets (%ld from "
-          "texture points, %ld with big parts, %ld with feelers meeting them, %ld through a core)",
-          count[1], own_clear, count[2], tex_sets, big_sets, big_met, blocked);
+          "texture points, %ld with big parts, %ld with feelers meeting them, %ld through a core, "
+          "%ld beside a host)",
+          count[1], own_clear, count[2], tex_sets, big_sets, big_met, blocked, shell);
     free(cases);
     free(out);
     fixture_close(&fx);

@@ -655,6 +655,13 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         g->flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
         object_bounds(&s->mesh, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris, 1u << 24,
                       g);
+        memcpy(g->own, g->bound, sizeof g->own);
+        if (o->ntex_tris > 0) { /* the sphere of its own triangles: the texture may reach out */
+            VbObject own;
+            memset(&own, 0, sizeof own);
+            object_bounds(&s->mesh, o->first_tri, o->ntris, 0, 0, 0, &own);
+            memcpy(g->own, own.bound, sizeof g->own);
+        }
         g->first_tri = o->first_tri;
         g->ntris = o->ntris;
         g->first_tex = o->first_tex_tri;
