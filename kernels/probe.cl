@@ -225,6 +225,22 @@ VB_INLINE float3 probe_cap_feeler(const ProbeCap *cap, int i, int k)
     return light_cap_at(u, cap->one_minus_cos, cap->tx, cap->ty, cap->wc);
 }
 
+/* For probe_cone_brute: 1 where the feeler (org, w, t) from sp starts outside some host and
+ * meets the bounding sphere of the host with its texture but not the sphere of its own
+ * triangles (VbObject.own). */
+VB_INLINE uint probe_beside_host(const DevScene *sc, const ShadePoint *sp, float3 org, float3 w,
+                                 float t)
+{
+    for (uint o = 0; o < sc->f->nobjects; o++) {
+        __global const VbObject *ho = sc->objects + o;
+        float2 c = sphere_chord(vload4(0, ho->own), org, w, t);
+        if ((ho->flags & VBCL_OBJECT_HOST) && sp->medium.host != (int)o &&
+            object_segment_meets(ho, org, w, t) && !(c.x <= t && c.y >= 0.0f))
+            return 1u;
+    }
+    return 0u;
+}
+
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
  * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
  * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
@@ -269,14 +285,7 @@ __kernel void probe_cone_brute(SCENE_KERNEL_ARGS __global const float *cases, in
             float3 w = probe_cap_feeler(&cap, i, k);
             if (dot(sp.ng, w) <= 0.0f) continue;
             float t_light = light_sphere_near(&ls, w, r);
-            for (uint o = 0; o < sc.f->nobjects; o++) {
-                __global const VbObject *ho = sc.objects + o;
-                float2 c = sphere_chord(vload4(0, ho->own), ls.origin, w, t_light);
-                if ((ho->flags & VBCL_OBJECT_HOST) && sp.medium.host != (int)o &&
-                    object_segment_meets(ho, ls.origin, w, t_light) &&
-                    !(c.x <= t_light && c.y >= 0.0f))
-                    shell = 1u;
-            }
+            shell |= probe_beside_host(&sc, &sp, ls.origin, w, t_light);
             int need = os.nbig > 0 ? object_set_feeler(&sc, &os, ls.origin, w, t_light,
                                                        sp.medium.tex_counts == 0u, sp.medium.host)
                                    : OBJECT_SET_ALONE;
