@@ -233,9 +233,9 @@ VB_INLINE uint probe_beside_host(const DevScene *sc, const ShadePoint *sp, float
 {
     for (uint o = 0; o < sc->f->nobjects; o++) {
         __global const VbObject *ho = sc->objects + o;
-        float2 c = sphere_chord(vload4(0, ho->own), org, w, t);
         if ((ho->flags & VBCL_OBJECT_HOST) && sp->medium.host != (int)o &&
-            object_segment_meets(ho, org, w, t) && !(c.x <= t && c.y >= 0.0f))
+            object_segment_meets(ho, org, w, t) &&
+            !sphere_stretch_meets(vload4(0, ho->own), org, w, (float2)(0.0f, t)))
             return 1u;
     }
     return 0u;

@@ -139,12 +139,18 @@ VB_INLINE float2 object_chord(__global const VbObject *ob, float3 org, float3 di
     return sphere_chord(vload4(0, ob->bound), org, dir, reach);
 }
 
-/* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet the
- * bounding sphere of record ob (conservative: margins as the cone test's). */
+/* Whether the stretch [st.x, st.y] of the line from org along the unit dir can meet sphere
+ * b (conservative: margins as the cone test's). */
+VB_INLINE int sphere_stretch_meets(float4 b, float3 org, float3 dir, float2 st)
+{
+    float2 c = sphere_chord(b, org, dir, st.y);
+    return c.x <= st.y && c.y >= st.x;
+}
+
+/* sphere_stretch_meets for the bounding sphere of record ob. */
 VB_INLINE int object_stretch_meets(__global const VbObject *ob, float3 org, float3 dir, float2 st)
 {
-    float2 c = object_chord(ob, org, dir, st.y);
-    return c.x <= st.y && c.y >= st.x;
+    return sphere_stretch_meets(vload4(0, ob->bound), org, dir, st);
 }
 
 /* Whether the segment from org along the unit dir to distance t can meet the bounding
@@ -237,10 +243,9 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
         __global const VbObject *ob = sc->objects + os->big[k];
         if (!object_segment_meets(ob, org, dir, t)) continue;
         if (os->big[k] < sc->f->nobjects) { /* an object, not a part */
-            if ((ob->flags & VBCL_OBJECT_HOST) && start_host != (int)os->big[k]) {
-                float2 c = sphere_chord(vload4(0, ob->own), org, dir, t);
-                if (!(c.x <= t && c.y >= 0.0f)) continue;
-            }
+            if ((ob->flags & VBCL_OBJECT_HOST) && start_host != (int)os->big[k] &&
+                !sphere_stretch_meets(vload4(0, ob->own), org, dir, (float2)(0.0f, t)))
+                continue;
             return OBJECT_SET_GRID;
         }
 #ifdef VBCL_HAS_TRANSPARENCY
