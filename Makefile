@@ -153,9 +153,10 @@ run: vbcl
 # ("Tracer caught signal 11") on a run with no leak. Dynamic TLS blocks are malloc'd and
 # reached from each thread's DTV, so the leak check does not need the interceptor.
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0)
-# Then the gallery script on two figures at 16x16 and every benchmark part on tiny images
-# (scripts/bench.py --quick), so that `make gallery` and `make bench` cannot rot; not in
-# sanitizer builds, whose timings mean nothing.
+# Then the gallery script on two figures at 16x16, every benchmark part on tiny images
+# (scripts/bench.py --quick) and scripts/bench_rays_compare.py on one, so that `make gallery`,
+# `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
+# mean nothing.
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
@@ -165,6 +166,10 @@ ifeq ($(SANITIZE),)
 	$(Q)scripts/bench.py --quick --vbcl $(BUILD)/vbcl --out $(BUILD)/bench-quick > $(BUILD)/bench-quick.log 2>&1 \
 	  && echo "bench --quick: every part ran ($(BUILD)/bench-quick/bench.md)" \
 	  || { tail -30 $(BUILD)/bench-quick.log; echo "bench --quick FAILED"; exit 1; }
+	$(Q)scripts/bench_rays_compare.py -n 1 --size 8 --repeats 1 $(BUILD)/vbcl-bench-rays \
+	  $(BUILD)/vbcl-bench-rays -- scenes/bench/spheres36.json > $(BUILD)/bench-rays-compare.log 2>&1 \
+	  && echo "bench_rays_compare.py: ran (spheres36, 8x8)" \
+	  || { tail -30 $(BUILD)/bench-rays-compare.log; echo "bench_rays_compare.py FAILED"; exit 1; }
 endif
 
 # The thesis's appendix figures A.1 ... A.8 at their own settings (400x400), one at a time:
