@@ -12,8 +12,8 @@ same rays, so its ratio vbcl / Embree is what is compared. Reports, per scene an
 each build's median ratio with the range over the rounds, its median vbcl Mrays/s, and the
 median ratio of each later build over the first (of the vbcl / Embree medians; of vbcl's
 Mrays/s where a build has no Embree). A bench run that fails (the two sides
-disagree, bad input) stops the comparison with its exit status. docs/benchmarks.md,
-"Against Embree".
+disagree, bad input) stops the comparison with its messages and exit status 1.
+docs/benchmarks.md, "Against Embree".
 """
 import argparse
 import json
@@ -33,10 +33,10 @@ def bench_path(arg):
     sys.exit(f"bench_rays_compare: {arg}: no vbcl-bench-rays binary there")
 
 
-def run(prog, scene, a, out):
-    """One bench run: {kind: (ratio, vbcl Mrays/s)}."""
+def run(prog, scene, a, repeats, out):
+    """One bench run of `repeats` timed repeats: {kind: (ratio or None, vbcl Mrays/s)}."""
     cmd = [prog, scene, "--width", str(a.size), "--height", str(a.size),
-           "--repeats", str(a.repeats), "--json", out]
+           "--repeats", str(repeats), "--json", out]
     if a.grid:
         cmd += ["--grid", a.grid]
     r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -77,11 +77,11 @@ def main():
         out = os.path.join(tmp, "rays.json")
         for scene in scenes:
             for p in progs:  # warm the kernel caches
-                run(p, scene, argparse.Namespace(**{**vars(a), "repeats": 1}), out)
+                run(p, scene, a, 1, out)
             res = [dict() for _ in progs]
             for _ in range(a.rounds):
                 for i, p in enumerate(progs):
-                    for kind, v in run(p, scene, a, out).items():
+                    for kind, v in run(p, scene, a, a.repeats, out).items():
                         res[i].setdefault(kind, []).append(v)
             report(scene, a, progs, res)
 
