@@ -2,9 +2,6 @@
 """bench_rays_compare.py — two or more builds of vbcl-bench-rays on the same scenes, run in
 interleaved rounds so that machine noise hits every build alike.
 
-usage: scripts/bench_rays_compare.py [-n ROUNDS] [--size N] [--repeats N] [--grid G]
-                                     BENCH BENCH [BENCH ...] -- SCENE [SCENE ...]
-
 BENCH is a vbcl-bench-rays binary, or a directory holding build/vbcl-bench-rays or
 vbcl-bench-rays (a checkout or its build folder). Each round runs every build once per
 scene (`--width N --height N --repeats R --json`); each run measures vbcl and Embree on the
