@@ -62,6 +62,8 @@ static const char usage_text[] =
     "      --all-feelers        every point of a ray tree gets all its feelers (default: a\n"
     "                           point whose share of its sample is w <= 1/4 gets about\n"
     "                           w x N of the N, at least one)\n"
+    "      --no-sample-shares   with --aa, a ray-tree point of a quadtree sample at level\n"
+    "                           L gets the feelers of its weight w, not of w x 2^-L\n"
     "      --penumbra-feelers K  a point whose first feelers toward a light disagree (a\n"
     "                           penumbra) traces K times as many (1, 2, 4, 8, 16; default\n"
     "                           4; 1 off; feelers of a power-of-two side only)\n"
@@ -115,6 +117,7 @@ typedef struct Options {
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
     int list_devices, stats, quiet, no_cone_test, no_camera_tiles, all_feelers, penumbra_feelers;
+    int no_sample_shares;
 } Options;
 
 static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -191,6 +194,7 @@ static const OptionSpec option_specs[] = {
     {"--no-cone-test", NULL, OPT_FLAG, offsetof(Options, no_cone_test), 0, 0},
     {"--no-camera-tiles", NULL, OPT_FLAG, offsetof(Options, no_camera_tiles), 0, 0},
     {"--all-feelers", NULL, OPT_FLAG, offsetof(Options, all_feelers), 0, 0},
+    {"--no-sample-shares", NULL, OPT_FLAG, offsetof(Options, no_sample_shares), 0, 0},
     {"--penumbra-feelers", NULL, OPT_INT, offsetof(Options, penumbra_feelers), 1,
      SCENE_PENUMBRA_FEELERS_MAX},
     {"--stats", NULL, OPT_FLAG, offsetof(Options, stats), 0, 0},
@@ -425,6 +429,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->no_cone_test) s->shadow_cone_test = 0;
     if (o->no_camera_tiles) s->camera_tiles = 0;
     if (o->all_feelers) s->shadow_by_weight = 0;
+    if (o->no_sample_shares) s->sample_shares = 0;
     if (o->penumbra_feelers > 0) s->penumbra_feelers = o->penumbra_feelers;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
     if (o->bands >= 0) {

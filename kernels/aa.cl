@@ -131,6 +131,16 @@ VB_INLINE uint aa_sample_id(uint pixel, int side, uint sub)
     return vb_hash(pixel ^ vb_hash(((uint)side << 16) ^ sub ^ 0x5bd1e995u));
 }
 
+/* The id of the quadtree sample in finest cell `cell` of a pixel, fresh at level `level`
+ * (1 .. 4): aa_sample_id of subpixel cell of 16 x 16, its top four bits replaced by 1 and
+ * the level, so that sample_share can read the level back. Pass 0's ids (pixel indices)
+ * have bit 31 clear. */
+VB_INLINE uint aa_tree_sample_id(uint pixel, uint cell, int level)
+{
+    return (aa_sample_id(pixel, AA_TREE_SIDE, cell) & 0x0fffffffu) | 0x80000000u |
+           (uint)level << 28;
+}
+
 /* The leaves of a tree slot, in cell order: leaf[i] = x | y << 8 | first cell << 16 |
  * level << 24, (x, y) its sample's position in half-cells from the pixel's corner (exact: a
  * cell's centre is odd, the pixel centre is 16, 16), the first cell the one holding its

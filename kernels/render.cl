@@ -94,6 +94,19 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     return sp;
 }
 
+/* The factor by which light_node_strata counts the weight of a ray-tree point of film
+ * sample `sample` (VbRay.sample): with VBCL_FRAME_SAMPLE_SHARES, 2^-L for a quadtree
+ * sample fresh at level L (aa_tree_sample_id), 1 for pass 0's. A sample at level L weighs
+ * about 4^-L in its pixel, but is compared with its neighbours at a threshold of about 2^L
+ * times the pixel's (aa_leaf_fails): its points' relative noise grows as 2^(L/2) with 2^-L
+ * of their feelers, slower than the threshold. The sample's own point keeps all of its
+ * feelers (its noise is what the contrast test sees first). */
+VB_INLINE float sample_share(__constant const VbFrame *f, uint sample)
+{
+    if (!(f->flags & VBCL_FRAME_SAMPLE_SHARES) || !(sample & 0x80000000u)) return 1.0f;
+    return 1.0f / (float)(1u << (sample >> 28 & 7u));
+}
+
 /* The jitter key of a film sample (VbRay.sample) under the frame's seed. */
 VB_INLINE uint sample_key(__constant const VbFrame *f, uint sample)
 {
@@ -201,8 +214,8 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 
 /* Traces the pending branches on the stack, depth first, until it is empty; returns the
  * radiance they carry to the sample. White rays that split record it in rec (may be 0). */
-VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, TreeCount *cnt, TraceCount *tc,
-                          ShadowCount *shc, __global VbSplitSet *rec)
+VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share, TreeCount *cnt,
+                          TraceCount *tc, ShadowCount *shc, __global VbSplitSet *rec)
 {
     __constant const VbFrame *f = sc->f;
     float3 acc = (float3)(0.0f);
@@ -220,8 +233,8 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, TreeCount *
         q.band = tr.band;
         __global const VbMaterial *ms = sc->materials + ph.cx.surface;
         if (ms->k_local > 0.0f)
-            acc += w * light_shade_local(sc, &q, light_node_strata(f, vb_max3(w) * ms->k_local), tc,
-                                         shc);
+            acc += w * light_shade_local(
+                           sc, &q, light_node_strata(f, vb_max3(w) * ms->k_local * share), tc, shc);
         if (ms->k_global > 0.0f)
             tree_spawn(sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, cnt, tr.band,
                        rec);
@@ -283,7 +296,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     ShadowCount shc = {0, 0, 0, 0, 0, 0};
     tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
                -1, rec);
-    float3 acc = tree_run(&sc, stack, n, &cnt, &tc, &shc, rec);
+    float3 acc = tree_run(&sc, stack, n, sample_share(f, r.sample), &cnt, &tc, &shc, rec);
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
 #ifdef VBCL_HAS_DISPERSION
     rec->budget = cnt.prune_budget;
@@ -309,6 +322,7 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     TraceCount tc = {0, 0};
     ShadowCount shc = {0, 0, 0, 0, 0, 0};
     float3 acc = (float3)(0.0f);
+    float share = sample_share(f, rays[i].sample);
     for (int k = 0; k < count; k++) {
         VbSplit s = rec->s[k];
         ShadePoint sp;
@@ -323,7 +337,7 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
         int n = 0;
         tree_push_bands(&sc, stack, &n, &sp, vload3(0, s.dir), &c, vload3(0, s.weight), s.depth,
                         s.key, &cnt);
-        acc += tree_run(&sc, stack, n, &cnt, &tc, &shc, 0);
+        acc += tree_run(&sc, stack, n, share, &cnt, &tc, &shc, 0);
     }
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
     tree_flush_counts(counters, &cnt, &tc, &shc);
@@ -413,7 +427,7 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     float2 at = aa_cell_position(cell);
     int x = (int)(m.x % (uint)f->width), y = (int)(m.x / (uint)f->width);
     rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,
-                         aa_sample_id(m.x, AA_TREE_SIDE, (uint)cell));
+                         aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
 }
 
 /* radiance, marks -> tree, slots, slot_pixels, changed: each marked node of a batch becomes

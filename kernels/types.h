@@ -302,6 +302,9 @@ typedef struct VbFrame {
         * object's bounds are not traced (light_cone_objects) */
 #define VBCL_FRAME_WEIGHTED_FEELERS                                                                \
     8u /* a ray-tree node gets feelers in proportion to its weight (light_node_strata) */
+#define VBCL_FRAME_SAMPLE_SHARES                                                                   \
+    16u /* adaptive anti-aliasing with feelers by weight: a quadtree sample's id carries its       \
+         * level, and its points count 2^-level of their weight (sample_share) */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */

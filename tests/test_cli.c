@@ -533,6 +533,90 @@ static void render_feelers(const char *scene, const char *tag, const char *opts,
     cJSON_Delete(doc);
 }
 
+/* One render of scene at 48 x 48 with opts: its image, its shadow feelers and its
+ * refinement samples. */
+static void render_shares(const char *scene, const char *tag, const char *opts, float **img, int *w,
+                          int *h, double *shadow, double *refinement)
+{
+    char out[8192], args[2048], path[512], json[512], err[512];
+    snprintf(path, sizeof path, "%s/share_%s.exr", tu_tmpdir(), tag);
+    snprintf(json, sizeof json, "%s/share_%s.json", tu_tmpdir(), tag);
+    snprintf(args, sizeof args, "%s -q --width 48 --height 48 -o %s --stats-json %s %s", scene,
+             path, json, opts);
+    CHECK(vbcl(args, out, sizeof out) == 0, "%s: %s", args, out);
+    if (image_read(path, w, h, img, err, sizeof err)) CHECK(0, "%s", err);
+    cJSON *doc = read_json(json);
+    *shadow = json_num(doc, "rays", "shadow", NULL);
+    *refinement = json_num(doc, "rays", "refinement", NULL);
+    cJSON_Delete(doc);
+}
+
+/* Sample shares (render.sample_shares, sample_share): with adaptive anti-aliasing and
+ * feelers by weight, the ray-tree points of a quadtree sample fresh at level L count 2^-L
+ * of their weight. On A.4 at --aa 0.05 the refinement samples trace fewer feelers each than
+ * with --no-sample-shares (pass 0, the same in both, subtracted), and the image's mean stays
+ * within 0.5%. Pass 0 alone (--aa 0), uniform supersampling (--ssaa 2) and a scene without
+ * ray trees (the quickstart, --aa 0.05) are bit for bit --no-sample-shares's. */
+static void test_cli_sample_shares(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    static const char *const a4 = "scenes/thesis/a4_two_prisms.json";
+    static const struct {
+        const char *scene, *opts;
+    } runs[] = {{a4, "--aa 0.05"},
+                {a4, "--aa 0"},
+                {a4, "--ssaa 2"},
+                {"scenes/quickstart.json", "--aa 0.05"}};
+    double shadow0 = 0;
+    for (int k = 0; k < 4; k++) {
+        float *img[2] = {NULL, NULL};
+        double shadow[2], refine[2], diff = 0, mean[2] = {0, 0};
+        int w = 0, h = 0;
+        char tag[16], opts[256];
+        for (int j = 0; j < 2; j++) {
+            snprintf(tag, sizeof tag, "%d%d", k, j);
+            snprintf(opts, sizeof opts, "%s%s", runs[k].opts, j ? " --no-sample-shares" : "");
+            render_shares(runs[k].scene, tag, opts, &img[j], &w, &h, &shadow[j], &refine[j]);
+        }
+        if (k == 0) { /* pass 0 of the same scene and size, for the feelers it traces */
+            float *plain = NULL;
+            double r0;
+            render_shares(a4, "plain", "--aa 0", &plain, &w, &h, &shadow0, &r0);
+            free(plain);
+        }
+        if (!img[0] || !img[1]) goto next;
+        for (int i = 0; i < w * h * 4; i++) {
+            diff = fmax(diff, fabs(img[0][i] - img[1][i]));
+            if (i % 4 == 3) continue; /* alpha */
+            mean[0] += img[0][i];
+            mean[1] += img[1][i];
+        }
+        if (k > 0) {
+            CHECK(diff == 0.0 && shadow[0] == shadow[1],
+                  "%s %s: differs from --no-sample-shares by %g (%g against %g feelers)",
+                  runs[k].scene, runs[k].opts, diff, shadow[0], shadow[1]);
+            goto next;
+        }
+        double per[2] = {(shadow[0] - shadow0) / refine[0], (shadow[1] - shadow0) / refine[1]};
+        CHECK(refine[0] > 500 && refine[1] > 500, "%g and %g refinement samples", refine[0],
+              refine[1]);
+        CHECK(per[0] < 0.9 * per[1], "%g feelers per refinement sample, %g without shares", per[0],
+              per[1]);
+        CHECK(fabs(mean[0] - mean[1]) <= 5e-3 * mean[1], "mean %g, %g without shares",
+              mean[0] / (3.0 * w * h), mean[1] / (3.0 * w * h));
+        printf("    A.4 %s: %.0f and %.0f refinement samples, %.2f and %.2f feelers each; mean "
+               "%.6g, %.6g\n",
+               runs[k].opts, refine[0], refine[1], per[0], per[1], mean[0] / (3.0 * w * h),
+               mean[1] / (3.0 * w * h));
+    next:
+        free(img[0]);
+        free(img[1]);
+    }
+}
+
 /* Feelers by weight (render.shadow_by_weight, light_node_strata): a point deeper in a ray
  * tree that weighs w <= 1/4 in its sample gets about w x 16 of the 16 feelers. On scenes
  * without ray trees the image is bit-identical to --all-feelers's; with them fewer feelers
@@ -927,5 +1011,6 @@ void suite_cli(void)
     RUN_TEST(test_cli_cone_test);
     RUN_TEST(test_cli_camera_tiles);
     RUN_TEST(test_cli_feelers_by_weight);
+    RUN_TEST(test_cli_sample_shares);
     RUN_TEST(test_cli_stats_json);
 }

@@ -750,6 +750,8 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     if (s->shadow_cone_test && s->nobjects <= VBCL_CONE_TEST_MAX_OBJECTS)
         f->flags |= VBCL_FRAME_CONE_TEST;
     if (s->shadow_by_weight) f->flags |= VBCL_FRAME_WEIGHTED_FEELERS;
+    if (s->shadow_by_weight && s->sample_shares && s->aa_threshold > 0.0f)
+        f->flags |= VBCL_FRAME_SAMPLE_SHARES;
     f->nobjects = (unsigned)s->nobjects;
     f->penumbra_factor = (unsigned)s->penumbra_feelers;
     scene_medium_at(s, s->eye, &f->camera_medium);

@@ -274,6 +274,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "shadow_cone_test",
                                        "camera_tiles",
                                        "shadow_by_weight",
+                                       "sample_shares",
                                        "penumbra_feelers",
                                        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
@@ -297,6 +298,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
     s->shadow_cone_test = 1;
     s->camera_tiles = 1;
     s->shadow_by_weight = 1;
+    s->sample_shares = 1;
     s->penumbra_feelers = SCENE_PENUMBRA_FEELERS;
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
@@ -321,6 +323,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         get_bool(c, j, "shadow_cone_test", &s->shadow_cone_test) ||
         get_bool(c, j, "camera_tiles", &s->camera_tiles) ||
         get_bool(c, j, "shadow_by_weight", &s->shadow_by_weight) ||
+        get_bool(c, j, "sample_shares", &s->sample_shares) ||
         get_choice(c, j, "fresnel", "exact", "thesis", &s->fresnel)) /* SCENE_FRESNEL_* */
         return -1;
     if (get_resolution(c, j, "grid", GRID_MAX_AXIS, s->grid_res) ||

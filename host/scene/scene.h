@@ -92,6 +92,9 @@ typedef struct Scene {
     int camera_tiles;     /* render.camera_tiles: 0 camera rays walk the grid (camera_tiles.h) */
     int shadow_by_weight; /* render.shadow_by_weight: feelers of ray-tree nodes by their weight
                            * (light_node_strata); 0: all shadow_samples at every node */
+    int sample_shares;    /* render.sample_shares: with shadow_by_weight and adaptive
+                           * anti-aliasing, a quadtree sample's ray-tree points count 2^-level
+                           * of their weight (sample_share); 0: 1 */
     int penumbra_feelers; /* render.penumbra_feelers: a point whose first feelers toward a light
                            * disagree traces this many times as many (light_penumbra); 1: never */
     int fresnel;          /* SCENE_FRESNEL_* */
