@@ -618,6 +618,13 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
     return radiance * brdf * vis * (cos_n / ls.d2);
 }
 
+/* The side s, halved while (s/2)^2 still holds at least `need` feelers (and above 1). */
+VB_INLINE uint light_halve_strata(uint s, float need)
+{
+    while (s > 1u && (float)((s >> 1) * (s >> 1)) >= need) s >>= 1;
+    return s;
+}
+
 /* The side of the feeler grid of a point deeper in a ray tree whose local term counts for
  * `weight` (the branch's weight times k_local, largest channel) in its sample: with
  * VBCL_FRAME_WEIGHTED_FEELERS, the frame's strata halved while the smaller grid still has
@@ -625,14 +632,18 @@ VB_INLINE float3 light_reflect_one(const DevScene *scn, __global const VbLight *
  * its share of the sample (at weight 1/4 a quarter of them, at 1/16 a sixteenth; never
  * fewer than one): the variance a node adds is weight^2 / feelers, and for a fixed number
  * of feelers in all, the sum over nodes is least with feelers in proportion to weight.
- * Otherwise, or for weight above 1/4, all of them. */
-VB_INLINE uint light_node_strata(__constant const VbFrame *f, float weight)
+ * Otherwise, or for weight above 1/4, all of them.
+ * `share` (sample_share: below 1 for an adaptive quadtree sample deeper than the pixel)
+ * multiplies the weight, but does not take the point below 2 x 2 where the weight alone
+ * gives at least that, so that light_penumbra still looks at its feelers (a single
+ * feeler's visibility is all or nothing, and its noise draws splits). */
+VB_INLINE uint light_node_strata(__constant const VbFrame *f, float weight, float share)
 {
     uint s = f->shadow_strata;
     if (!(f->flags & VBCL_FRAME_WEIGHTED_FEELERS)) return s;
-    float need = weight * (float)(s * s);
-    while (s > 1u && (float)((s >> 1) * (s >> 1)) >= need) s >>= 1;
-    return s;
+    uint by_weight = light_halve_strata(s, weight * (float)(s * s));
+    if (share >= 1.0f) return by_weight;
+    return max(min(by_weight, 2u), light_halve_strata(by_weight, weight * share * (float)(s * s)));
 }
 
 /* Local radiance toward the viewer at sp (thesis figure 4.7, the k_local term):

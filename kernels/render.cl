@@ -234,7 +234,7 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share
         __global const VbMaterial *ms = sc->materials + ph.cx.surface;
         if (ms->k_local > 0.0f)
             acc += w * light_shade_local(
-                           sc, &q, light_node_strata(f, vb_max3(w) * ms->k_local * share), tc, shc);
+                           sc, &q, light_node_strata(f, vb_max3(w) * ms->k_local, share), tc, shc);
         if (ms->k_global > 0.0f)
             tree_spawn(sc, stack, &n, &q, tr.dir, &ph.cx, state, w, tr.depth + 1, cnt, tr.band,
                        rec);
