@@ -171,6 +171,18 @@ VB_INLINE int aa_sample_d2(uint l, int cx, int cy)
     return dx * dx + dy * dy;
 }
 
+/* Whether the sample of leaf code l (aa_leaf_list) is at least as near as the sample at
+ * (hx, hy) to some cell centre of the rectangle lx .. hx2, ly .. hy2 (half-cells): the
+ * cells where it is, d^2(l, c) - d^2(h, c) <= 0, lie on one side of a straight line (the
+ * difference is linear in c), so the rectangle's corner that minimises it decides. Exact:
+ * a sample that fails is neither nearer nor tied anywhere in the rectangle. */
+VB_INLINE int aa_sample_may_win(uint l, int hx, int hy, int lx, int ly, int hx2, int hy2)
+{
+    int jx = (int)(l & 255u), jy = (int)(l >> 8 & 255u), dx = hx - jx, dy = hy - jy;
+    int px = dx >= 0 ? lx : hx2, py = dy >= 0 ? ly : hy2;
+    return 2 * (px * dx + py * dy) + jx * jx + jy * jy - hx * hx - hy * hy <= 0;
+}
+
 /* The weights of the n leaves' samples (aa_leaf_list) for a pixel's value: w[i] is the
  * number of finest cells whose centre lies nearer to sample i than to any other, a cell
  * equally near to m samples counted 1/m to each (the areas of the samples' Voronoi cells
@@ -178,7 +190,9 @@ VB_INLINE int aa_sample_d2(uint l, int cx, int cy)
  * Leaf by leaf: no sample is nearer to a cell of the leaf than the leaf's own sample is
  * to its farthest cell, so the candidates for all its cells are the samples lying in the
  * cells within that distance of the leaf (held: the leaf whose sample lies in each cell,
- * the pixel centre's in cell (8, 8)), or every leaf where those cells are more. Scalar code:
+ * the pixel centre's in cell (8, 8)), or every leaf where those cells are more, less each
+ * sample that is farther than the leaf's own from every cell of the leaf
+ * (aa_sample_may_win). Scalar code:
  * oclgrind 21.10 computed a search over every leaf written in int4 or int16 lanes wrongly where
  * PoCL ran it right. */
 VB_INLINE void aa_nearest_weights(const uint *leaf, int n, float *w)
@@ -203,10 +217,14 @@ VB_INLINE void aa_nearest_weights(const uint *leaf, int n, float *w)
         int m = 0;
         if ((x1 - x0 + 1) * (y1 - y0 + 1) < n) {
             for (int y = y0; y <= y1; y++)
-                for (int x = x0; x <= x1; x++)
-                    if (held[y * AA_TREE_SIDE + x] >= 0) cand[m++] = held[y * AA_TREE_SIDE + x];
+                for (int x = x0; x <= x1; x++) {
+                    int j = held[y * AA_TREE_SIDE + x];
+                    if (j >= 0 && aa_sample_may_win(leaf[j], hx, hy, lx, ly, hx2, hy2))
+                        cand[m++] = (short)j;
+                }
         } else {
-            for (int j = 0; j < n; j++) cand[m++] = (short)j;
+            for (int j = 0; j < n; j++)
+                if (aa_sample_may_win(leaf[j], hx, hy, lx, ly, hx2, hy2)) cand[m++] = (short)j;
         }
         for (int cy = ly; cy <= hy2; cy += 2)
             for (int cx = lx; cx <= hx2; cx += 2) {
