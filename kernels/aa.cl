@@ -7,8 +7,8 @@
  * slot of 256 float4 finest cells; each cell holds the value of the leaf that covers it
  * (rgb) and that leaf's level (w). A leaf at level L covers 4^(4-L) cells, so the
  * area-weighted mean of the leaves is the plain mean of the cells; the default
- * reconstruction instead weighs each leaf's sample by the cells nearest to it
- * (aa_nearest_weights). */
+ * reconstruction instead weighs each sample, the pixel's own or a refined neighbour's, by
+ * the pixel's cells nearest to it (aa_nearest_weights). */
 #ifndef VBCL_AA_CL
 #define VBCL_AA_CL
 
@@ -141,26 +141,67 @@ VB_INLINE uint aa_tree_sample_id(uint pixel, uint cell, int level)
            (uint)level << 28;
 }
 
-/* The leaves of a tree slot, in cell order: leaf[i] = x | y << 8 | first cell << 16 |
- * level << 24, (x, y) its sample's position in half-cells from the pixel's corner (exact: a
- * cell's centre is odd, the pixel centre is 16, 16), the first cell the one holding its
- * value. Returns their number; *deepest gets the deepest level. */
+/* The reconstruction also uses the samples of the adjacent pixels' trees that lie in their
+ * cells within AA_BAND finest cells of the pixel (a pixel's centre sample counts as lying
+ * in its cell (8, 8)): positions are in half-cells of the square of AA_EXT_SIDE cells
+ * around the pixel, the pixel itself from 2 * AA_BAND to 2 * (AA_BAND + AA_TREE_SIDE). */
+#define AA_BAND     8
+#define AA_EXT_SIDE (AA_TREE_SIDE + 2 * AA_BAND)
+#define AA_EXT_MAX  (4 * VBCL_AA_CELLS) /* own 256; sides 4 x 128, corners 4 x 64 */
+#define AA_OWN      4u                  /* the source of the pixel's own samples */
+
+/* The code of the sample of a leaf at level lv whose sample cell is `at` (which holds the
+ * leaf's value, as all its cells do) in the tree of pixel `src` (0 .. 8, row-major over the
+ * 3 x 3 pixels, AA_OWN the pixel itself), offset by (ox, oy) half-cells:
+ * x | y << 8 | at << 16 | lv << 24 | src << 28, (x, y) the sample's position in half-cells
+ * of the square around the pixel (exact: a cell's centre is odd, a pixel's centre even). */
+VB_INLINE uint aa_sample_code(int at, int lv, uint src, int ox, int oy)
+{
+    int hx = at == AA_TREE_CENTRE_CELL ? AA_TREE_SIDE : 2 * (at % AA_TREE_SIDE) + 1;
+    int hy = at == AA_TREE_CENTRE_CELL ? AA_TREE_SIDE : 2 * (at / AA_TREE_SIDE) + 1;
+    return (uint)(hx + ox) | (uint)(hy + oy) << 8 | (uint)at << 16 | (uint)lv << 24 | src << 28;
+}
+
+/* The leaves of the cells fx0 .. fx1 - 1, fy0 .. fy1 - 1 of a tree slot (a region whose
+ * bounds are multiples of 8 cells, so that each leaf below the pixel lies wholly in it or
+ * out of it), in the order of their first cells, appended to leaf from n on
+ * (aa_sample_code: held in the leaf's sample cell, source src, offset (ox, oy)). Each row
+ * is walked one leaf at a time (the next leaf along a row starts at the next multiple of
+ * the current one's size). Returns the new count; *deepest gets the deepest level. */
+VB_INLINE int aa_region_leaves(__global const float *cells, int fx0, int fx1, int fy0, int fy1,
+                               uint src, int ox, int oy, uint *leaf, int n, int *deepest)
+{
+    for (int fy = fy0; fy < fy1; fy++)
+        for (int fx = fx0; fx < fx1;) {
+            int lv = (int)cells[4 * (fy * AA_TREE_SIDE + fx) + 3], s = AA_TREE_SIDE >> lv;
+            *deepest = max(*deepest, lv);
+            if (fy % s == 0) {
+                int at = aa_node_sample_cell(lv, fx / s, fy / s);
+                leaf[n++] = aa_sample_code(at, lv, src, ox, oy);
+            }
+            fx = (fx / s + 1) * s;
+        }
+    return n;
+}
+
+/* The leaves of a tree slot (aa_region_leaves over the whole pixel). */
 VB_INLINE int aa_leaf_list(__global const float *cells, uint *leaf, int *deepest)
 {
-    int n = 0;
-    for (int k = 0; k < VBCL_AA_CELLS; k++) {
-        int lv = (int)cells[4 * k + 3], s = AA_TREE_SIDE >> lv;
-        int fx = k % AA_TREE_SIDE, fy = k / AA_TREE_SIDE;
-        *deepest = max(*deepest, lv);
-        if (fx % s || fy % s) continue;
-        int at = aa_node_sample_cell(lv, fx / s, fy / s);
-        uint hx =
-            at == AA_TREE_CENTRE_CELL ? (uint)AA_TREE_SIDE : 2u * (uint)(at % AA_TREE_SIDE) + 1u;
-        uint hy =
-            at == AA_TREE_CENTRE_CELL ? (uint)AA_TREE_SIDE : 2u * (uint)(at / AA_TREE_SIDE) + 1u;
-        leaf[n++] = hx | hy << 8 | (uint)k << 16 | (uint)lv << 24;
-    }
-    return n;
+    return aa_region_leaves(cells, 0, AA_TREE_SIDE, 0, AA_TREE_SIDE, AA_OWN, 2 * AA_BAND,
+                            2 * AA_BAND, leaf, 0, deepest);
+}
+
+/* The samples of the tree of the adjacent pixel at (dx, dy) (each -1 .. 1) that lie in its
+ * cells within AA_BAND cells of the pixel, appended to leaf from n on. Returns the new
+ * count. */
+VB_INLINE int aa_band_list(__global const float *cells, int dx, int dy, uint *leaf, int n)
+{
+    int x0 = dx < 0 ? AA_TREE_SIDE - AA_BAND : 0, x1 = dx > 0 ? AA_BAND : AA_TREE_SIDE;
+    int y0 = dy < 0 ? AA_TREE_SIDE - AA_BAND : 0, y1 = dy > 0 ? AA_BAND : AA_TREE_SIDE;
+    int deepest = 0;
+    return aa_region_leaves(cells, x0, x1, y0, y1, (uint)((dy + 1) * 3 + dx + 1),
+                            2 * (AA_BAND + dx * AA_TREE_SIDE), 2 * (AA_BAND + dy * AA_TREE_SIDE),
+                            leaf, n, &deepest);
 }
 
 /* The squared distance in half-cells from a cell's centre (cx, cy) to the sample of leaf
@@ -183,42 +224,44 @@ VB_INLINE int aa_sample_may_win(uint l, int hx, int hy, int lx, int ly, int hx2,
     return 2 * (px * dx + py * dy) + jx * jx + jy * jy - hx * hx - hy * hy <= 0;
 }
 
-/* The weights of the n leaves' samples (aa_leaf_list) for a pixel's value: w[i] is the
- * number of finest cells whose centre lies nearer to sample i than to any other, a cell
- * equally near to m samples counted 1/m to each (the areas of the samples' Voronoi cells
- * over the pixel, at the resolution of the cells). Over the 256 cells they sum to 256.
+/* The weights of the n samples (aa_sample_code: the pixel's own leaves first, nown of
+ * them, then its neighbours' band) for a pixel's value: w[i] is the number of the pixel's
+ * finest cells whose centre lies nearer to sample i than to any other, a cell equally near
+ * to m samples counted 1/m to each (the areas of the samples' Voronoi cells over the
+ * pixel, at the resolution of the cells). Over the 256 cells they sum to 256.
  * Leaf by leaf: no sample is nearer to a cell of the leaf than the leaf's own sample is
  * to its farthest cell, so the candidates for all its cells are the samples lying in the
- * cells within that distance of the leaf (held: the leaf whose sample lies in each cell,
- * the pixel centre's in cell (8, 8)), or every leaf where those cells are more, less each
- * sample that is farther than the leaf's own from every cell of the leaf
- * (aa_sample_may_win). Scalar code:
+ * cells within that distance of the leaf (held: the sample lying in each cell of the
+ * square around the pixel, a pixel centre's in its cell (8, 8)), or every sample where
+ * those cells are more, less each sample that is farther than the leaf's own from every
+ * cell of the leaf (aa_sample_may_win). Scalar code:
  * oclgrind 21.10 computed a search over every leaf written in int4 or int16 lanes wrongly where
  * PoCL ran it right. */
-VB_INLINE void aa_nearest_weights(const uint *leaf, int n, float *w)
+VB_INLINE void aa_nearest_weights(const uint *leaf, int n, int nown, float *w)
 {
-    short held[VBCL_AA_CELLS], cand[VBCL_AA_CELLS];
-    for (int k = 0; k < VBCL_AA_CELLS; k++) held[k] = -1;
+    short held[AA_EXT_SIDE * AA_EXT_SIDE], cand[AA_EXT_MAX];
+    for (int k = 0; k < AA_EXT_SIDE * AA_EXT_SIDE; k++) held[k] = -1;
     for (int i = 0; i < n; i++) {
-        held[(int)(leaf[i] >> 8 & 255u) / 2 * AA_TREE_SIDE + (int)(leaf[i] & 255u) / 2] = (short)i;
+        held[(int)(leaf[i] >> 8 & 255u) / 2 * AA_EXT_SIDE + (int)(leaf[i] & 255u) / 2] = (short)i;
         w[i] = 0.0f;
     }
-    for (int i = 0; i < n; i++) {
-        int first = (int)(leaf[i] >> 16 & 255u), s = AA_TREE_SIDE >> (int)(leaf[i] >> 24);
+    for (int i = 0; i < nown; i++) {
+        int at = (int)(leaf[i] >> 16 & 255u), s = AA_TREE_SIDE >> (int)(leaf[i] >> 24 & 15u);
         int hx = (int)(leaf[i] & 255u), hy = (int)(leaf[i] >> 8 & 255u);
-        int lx = 2 * (first % AA_TREE_SIDE) + 1, ly = 2 * (first / AA_TREE_SIDE) + 1;
+        int lx = 2 * (at % AA_TREE_SIDE / s * s + AA_BAND) + 1; /* the leaf's first cell */
+        int ly = 2 * (at / AA_TREE_SIDE / s * s + AA_BAND) + 1;
         int hx2 = lx + 2 * (s - 1), hy2 = ly + 2 * (s - 1); /* the last cell centres */
         int ax = max(abs(lx - hx), abs(hx2 - hx)), ay = max(abs(ly - hy), abs(hy2 - hy));
         /* a candidate lies within r half-cells of some cell centre of the leaf; a cell's
-         * centre is odd, the pixel centre (even) on the corner of cell (8, 8), hence the 1 */
+         * centre is odd, a pixel centre (even) on the corner of its cell (8, 8), hence the 1 */
         int r = (int)ceil(sqrt((float)(ax * ax + ay * ay))) + 1;
-        int x0 = max(lx - r, 0) / 2, x1 = min(hx2 + r, 2 * AA_TREE_SIDE - 1) / 2;
-        int y0 = max(ly - r, 0) / 2, y1 = min(hy2 + r, 2 * AA_TREE_SIDE - 1) / 2;
+        int x0 = max(lx - r, 0) / 2, x1 = min(hx2 + r, 2 * AA_EXT_SIDE - 1) / 2;
+        int y0 = max(ly - r, 0) / 2, y1 = min(hy2 + r, 2 * AA_EXT_SIDE - 1) / 2;
         int m = 0;
         if ((x1 - x0 + 1) * (y1 - y0 + 1) < n) {
             for (int y = y0; y <= y1; y++)
                 for (int x = x0; x <= x1; x++) {
-                    int j = held[y * AA_TREE_SIDE + x];
+                    int j = held[y * AA_EXT_SIDE + x];
                     if (j >= 0 && aa_sample_may_win(leaf[j], hx, hy, lx, ly, hx2, hy2))
                         cand[m++] = (short)j;
                 }

@@ -12,7 +12,7 @@
  *   aa_contrast_mark        film, tree         -> marks (quadtree leaves to split)
  *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
  *   aa_split_store          radiance, marks    -> tree (four leaves for each split node)
- *   aa_resolve              tree               -> film, info (each pixel from its samples)
+ *   aa_resolve              tree, slots        -> film, info (each pixel from its samples)
  * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
  * adds the pass, aa_split_rays the pass and the list, with dispersion the tree kernels add
  * the split records, the other aa_* kernels take only their own buffers), are
@@ -463,30 +463,48 @@ __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2
         aa_fill_node(cells, aa_new_child(m.y, k), vload4(3 * j + (uint)k, radiance).xyz, lv);
 }
 
-/* tree, slot_pixels -> film, info: each refined pixel becomes the mean of its finest cells
- * (a box window over the pixel's own footprint, figure 4.4), each cell the value of the
- * sample nearest to it (aa_nearest_weights) or, with aa->reconstruct 1, of the leaf
- * covering it (the area-weighted mean of the leaves, the thesis's); info its deepest
- * level | leaf count << 8. */
+/* tree, slot_pixels, slots -> film, info: each refined pixel becomes the mean of its finest
+ * cells (a box window over the pixel's own footprint, figure 4.4), each cell the value of
+ * the sample nearest to it among the pixel's own and its refined neighbours' near it
+ * (aa_nearest_weights; from[s] is the tree slot of the pixel at source s) or, with
+ * aa->reconstruct 1, of the leaf covering it (the area-weighted mean of the leaves, the
+ * thesis's); info its deepest level | leaf count << 8. */
 __kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot_pixels,
-                         __global const float *tree, __global float *film, __global int *info)
+                         __global const float *tree, __global float *film, __global int *info,
+                         __global const int *slots)
 {
     uint slot = get_global_id(0);
     if (slot >= aa->entries) return;
     __global const float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
-    uint leaf[VBCL_AA_CELLS];
-    float w[VBCL_AA_CELLS];
-    int deepest = 0, n = aa_leaf_list(cells, leaf, &deepest);
+    uint leaf[AA_EXT_MAX];
+    float w[AA_EXT_MAX];
+    int p = slot_pixels[slot];
+    int deepest = 0, nown = aa_leaf_list(cells, leaf, &deepest);
     float3 sum = (float3)(0.0f);
     if (aa->reconstruct == 1) { /* each cell holds the value of the leaf covering it */
         for (int k = 0; k < VBCL_AA_CELLS; k++) sum += vload4(k, cells).xyz;
     } else {
-        aa_nearest_weights(leaf, n, w);
-        for (int i = 0; i < n; i++) sum += w[i] * vload4(leaf[i] >> 16 & 255u, cells).xyz;
+        int x = p % aa->width, y = p / aa->width, n = nown, from[9];
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                int q = (y + dy) * aa->width + x + dx, src = (dy + 1) * 3 + dx + 1;
+                from[src] = (int)slot;
+                if (src == (int)AA_OWN || x + dx < 0 || x + dx >= aa->width || y + dy < 0 ||
+                    y + dy >= aa->height || slots[q] < 0)
+                    continue;
+                from[src] = slots[q];
+                n = aa_band_list(tree + (size_t)slots[q] * VBCL_AA_CELLS * 4, dx, dy, leaf, n);
+            }
+        aa_nearest_weights(leaf, n, nown, w);
+        for (int i = 0; i < n; i++)
+            if (w[i] > 0.0f)
+                sum += w[i] *
+                       vload4((size_t)from[leaf[i] >> 28] * VBCL_AA_CELLS + (leaf[i] >> 16 & 255u),
+                              tree)
+                           .xyz;
     }
-    int p = slot_pixels[slot];
     vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
-    info[p] = deepest | n << 8;
+    info[p] = deepest | nown << 8;
 }
 
 #ifdef VBCL_TEST_KERNELS

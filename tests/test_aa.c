@@ -630,15 +630,64 @@ static void resolve_sample_half(unsigned code, int *hx, int *hy)
     *hy = cell == AA_TREE_CENTRE_CELL ? AA_TREE_SIDE : 2 * (cell / AA_TREE_SIDE) + 1;
 }
 
-/* The reconstruction (aa_resolve), run on trees made here: random refinements of a pixel
- * (as in the test above) whose leaves get random values. With reconstruct 1 each pixel is
- * the mean of its 256 finest cells, each the value of the leaf covering it (the leaves'
- * area-weighted mean); with 0 (the default) each cell takes the value of the sample
- * nearest to its centre, a cell equally near to several the mean of theirs, computed here
- * in double by a search of its own. First a pixel split once, by hand: its centre sample
- * (kept by the child at (1, 1)) is nearest to 82 of the 256 cells, the new samples of the
+/* The nearest-sample value of cell (cx, cy) (half-cells) of the pixel at (px, py) of the
+ * resolve test's image: the mean of the values of the nearest samples among those of the
+ * pixel's own tree and of its refined neighbours' lying in cells within 8 cells of the
+ * pixel (a pixel's centre sample in its cell (8, 8)), computed in double. */
+enum { RES_W = 12, RES_H = 11, RES_TREES = 100 };
+static double resolve_cell_nearest(const int *tree_at, const unsigned (*leaves)[VBCL_AA_CELLS],
+                                   const int *nleaves, const float (*value)[VBCL_AA_CELLS], int px,
+                                   int py, int cx, int cy)
+{
+    double best = 1e30, sum = 0.0;
+    int ties = 0;
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            int qx = px + dx, qy = py + dy;
+            if (qx < 0 || qx >= RES_W || qy < 0 || qy >= RES_H) continue;
+            int t = tree_at[qy * RES_W + qx];
+            if (t < 0) continue;
+            for (int i = 0; i < nleaves[t]; i++) {
+                unsigned c = leaves[t][i];
+                int cell = aa_node_sample_cell(aa_node_level(c), aa_node_x(c), aa_node_y(c));
+                int sx = cell % AA_TREE_SIDE + AA_TREE_SIDE * dx;
+                int sy = cell / AA_TREE_SIDE + AA_TREE_SIDE * dy;
+                if (sx < -8 || sx >= AA_TREE_SIDE + 8 || sy < -8 || sy >= AA_TREE_SIDE + 8)
+                    continue;
+                int hx, hy;
+                resolve_sample_half(c, &hx, &hy);
+                hx += 2 * AA_TREE_SIDE * dx;
+                hy += 2 * AA_TREE_SIDE * dy;
+                double d = (double)(hx - cx) * (hx - cx) + (double)(hy - cy) * (hy - cy);
+                if (d < best) {
+                    best = d;
+                    sum = 0.0;
+                    ties = 0;
+                }
+                if (d == best) {
+                    sum += value[t][i];
+                    ties++;
+                }
+            }
+        }
+    return sum / ties;
+}
+
+/* The reconstruction (aa_resolve), run on trees made here: random refinements of the
+ * pixels of a 12 x 11 image (as in the test above; a column and the last rows unrefined)
+ * whose leaves get random values. With reconstruct 1 each pixel is the mean of its 256
+ * finest cells, each the value of the leaf covering it (the leaves' area-weighted mean);
+ * with 0 (the default) each cell takes the value of the sample nearest to its centre
+ * among the pixel's own and its refined neighbours' within 8 cells of it, a cell equally
+ * near to several the mean of theirs, computed here in double by a search of its own.
+ * First a pixel split once, by hand, with no refined neighbour: its centre sample (kept
+ * by the child at (1, 1)) is nearest to 82 of the 256 cells, the new samples of the
  * children (0, 0), (1, 0) and (0, 1) to 54, 60 and 60 (the leaves' weights would be 64
- * each). info is the deepest level | leaves << 8. */
+ * each). Then a row of pixels each split once, every leaf 1 but the centre samples 0: a
+ * right neighbour's samples take 19 of the 82 cells of a pixel's centre sample (a left
+ * one's none: the fresh samples either side of the border are as far from it), so the
+ * centre sample weighs 63 cells, where the leaves would give it 64. info is the deepest
+ * level | leaves << 8. */
 static void test_aa_resolve_nearest_samples(void)
 {
     Fixture fx;
@@ -646,29 +695,43 @@ static void test_aa_resolve_nearest_samples(void)
                           "\"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}}, "
                           "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
         return;
-    enum { TREES = 101 };
+    enum { TREES = RES_TREES, NPIX = RES_W * RES_H };
     static float tree[TREES * VBCL_AA_CELLS * 4];
     static unsigned leaves[TREES][VBCL_AA_CELLS];
     static float value[TREES][VBCL_AA_CELLS];
-    int nleaves[TREES], deepest[TREES], pixels[TREES];
+    int nleaves[TREES], deepest[TREES], pixels[TREES], tree_at[NPIX], slots[NPIX];
     unsigned rng = 2024;
+    /* tree 0 alone at (0, 10), trees 1 .. 4 in a row at (5 .. 8, 10), each split once; the
+     * others over rows 0 .. 8, column 7 left unrefined */
+    for (int p = 0; p < NPIX; p++) tree_at[p] = -1;
+    for (int t = 0, p = 0; t < TREES; t++) {
+        if (t == 0)
+            pixels[t] = 10 * RES_W;
+        else if (t <= 4)
+            pixels[t] = 10 * RES_W + 4 + t;
+        else {
+            while (p % RES_W == 7) p++;
+            pixels[t] = p++;
+        }
+        tree_at[pixels[t]] = t;
+    }
+    for (int p = 0; p < NPIX; p++) slots[p] = tree_at[p];
     for (int t = 0; t < TREES; t++) {
         int n = 1;
         leaves[t][0] = aa_node_code(0, 0, 0);
-        int steps = t == 0 ? 1 : 1 + t % 60;
+        int once = t <= 4, steps = once ? 1 : 1 + t % 60;
         for (int step = 0; step < steps; step++) {
             rng = rng * 1103515245u + 12345u;
-            int i = t == 0 ? 0 : (int)((rng >> 8) % (unsigned)n);
+            int i = once ? 0 : (int)((rng >> 8) % (unsigned)n);
             if (aa_node_level(leaves[t][i]) < VBCL_AA_MAX_LEVEL) split_leaf(leaves[t], &n, i);
         }
         nleaves[t] = n;
         deepest[t] = 0;
-        pixels[t] = t;
         for (int i = 0; i < n; i++) {
             unsigned c = leaves[t][i];
             rng = rng * 1103515245u + 12345u;
-            value[t][i] = t == 0 ? (c == aa_node_code(1, 1, 1) ? 1.0f : 0.0f)
-                                 : (float)((rng >> 8) % 1000u) / 250.0f; /* 0 .. 4 */
+            value[t][i] = once ? (c == aa_node_code(1, 1, 1)) == (t == 0) ? 1.0f : 0.0f
+                               : (float)((rng >> 8) % 1000u) / 250.0f; /* 0 .. 4 */
             int lv = aa_node_level(c), s = AA_TREE_SIDE >> lv;
             deepest[t] = lv > deepest[t] ? lv : deepest[t];
             for (int y = aa_node_y(c) * s; y < (aa_node_y(c) + 1) * s; y++)
@@ -683,69 +746,81 @@ static void test_aa_resolve_nearest_samples(void)
         }
     }
     for (int mode = 0; mode < 2; mode++) {
-        float film[TREES * 4];
-        int info[TREES];
+        float film[NPIX * 4];
+        int info[NPIX];
         VbAaPass pass;
         memset(&pass, 0, sizeof pass);
         pass.entries = TREES;
         pass.reconstruct = mode;
+        pass.width = RES_W;
+        pass.height = RES_H;
         memset(film, 0, sizeof film);
         memset(info, 0, sizeof info);
-        cl_mem m[5] = {buffer(&pass, sizeof pass), buffer(pixels, sizeof pixels),
-                       buffer(tree, sizeof tree), buffer(film, sizeof film),
-                       buffer(info, sizeof info)};
-        const size_t sz[5] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                              sizeof(cl_mem)};
-        const void *v[5] = {&m[0], &m[1], &m[2], &m[3], &m[4]};
-        if (run_kernel(fx.r.program, "aa_resolve", TREES, 5, sz, v) == 0) {
+        cl_mem m[6] = {buffer(&pass, sizeof pass), buffer(pixels, sizeof pixels),
+                       buffer(tree, sizeof tree),  buffer(film, sizeof film),
+                       buffer(info, sizeof info),  buffer(slots, sizeof slots)};
+        size_t sz[6];
+        const void *v[6];
+        for (int i = 0; i < 6; i++) {
+            sz[i] = sizeof(cl_mem);
+            v[i] = &m[i];
+        }
+        if (run_kernel(fx.r.program, "aa_resolve", TREES, 6, sz, v) == 0) {
             read_buffer(m[3], film, sizeof film);
             read_buffer(m[4], info, sizeof info);
-            int bad = 0, bad_info = 0;
+            int bad = 0, bad_info = 0, differs = 0;
             double worst = 0.0;
             for (int t = 0; t < TREES; t++) {
-                double want = 0.0;
+                int px = pixels[t] % RES_W, py = pixels[t] / RES_W;
+                double want = 0.0, own = 0.0;
                 for (int k = 0; k < VBCL_AA_CELLS; k++) {
                     int cx = 2 * (k % AA_TREE_SIDE) + 1, cy = 2 * (k / AA_TREE_SIDE) + 1;
-                    double best = 1e30, sum = 0.0;
-                    int ties = 0;
-                    for (int i = 0; i < nleaves[t]; i++) {
-                        unsigned c = leaves[t][i];
-                        int s = AA_TREE_SIDE >> aa_node_level(c);
-                        int in = k % AA_TREE_SIDE / s == aa_node_x(c) &&
-                                 k / AA_TREE_SIDE / s == aa_node_y(c);
-                        int hx, hy;
-                        resolve_sample_half(c, &hx, &hy);
-                        double d =
-                            mode ? (in ? 0.0 : 1e29)
-                                 : (double)(hx - cx) * (hx - cx) + (double)(hy - cy) * (hy - cy);
-                        if (d < best) {
-                            best = d;
-                            sum = 0.0;
-                            ties = 0;
+                    int lone[NPIX];
+                    for (int q = 0; q < NPIX; q++) lone[q] = q == pixels[t] ? t : -1;
+                    if (mode) {
+                        for (int i = 0; i < nleaves[t]; i++) {
+                            unsigned c = leaves[t][i];
+                            int s = AA_TREE_SIDE >> aa_node_level(c);
+                            if (k % AA_TREE_SIDE / s == aa_node_x(c) &&
+                                k / AA_TREE_SIDE / s == aa_node_y(c))
+                                want += value[t][i];
                         }
-                        if (d == best) {
-                            sum += value[t][i];
-                            ties++;
-                        }
+                    } else {
+                        want +=
+                            resolve_cell_nearest(tree_at, leaves, nleaves, value, px, py, cx, cy);
+                        own += resolve_cell_nearest(lone, leaves, nleaves, value, px, py, cx, cy);
                     }
-                    want += sum / ties;
                 }
                 want /= VBCL_AA_CELLS;
-                double err = fabs(film[4 * t] - want);
+                own /= VBCL_AA_CELLS;
+                double err = fabs(film[4 * pixels[t]] - want);
                 worst = err > worst ? err : worst;
                 bad += err > 1e-5 * (1.0 + want);
-                bad_info += info[t] != (deepest[t] | nleaves[t] << 8);
+                differs += !mode && fabs(own - want) > 1e-3;
+                bad_info += info[pixels[t]] != (deepest[t] | nleaves[t] << 8);
             }
             CHECK(bad == 0 && bad_info == 0,
                   "reconstruct %d: %d of %d pixels off their cells' mean (worst %.3g), %d infos "
                   "wrong",
                   mode, bad, TREES, worst, bad_info);
+            /* the test has teeth: the neighbours' samples change most pixels */
+            CHECK(mode || differs > TREES / 2,
+                  "only %d of %d pixels differ from their own samples' reconstruction", differs,
+                  TREES);
             double split_once = mode ? 64.0 / 256.0 : 82.0 / 256.0;
-            CHECK(fabs(film[0] - split_once) < 1e-6 && fabs(film[2] - (1.0 - split_once)) < 1e-6,
+            float *lone = film + 4 * pixels[0];
+            CHECK(fabs(lone[0] - split_once) < 1e-6 && fabs(lone[2] - (1.0 - split_once)) < 1e-6,
                   "reconstruct %d, a pixel split once: the centre sample weighs %.6f, not %.6f",
-                  mode, film[0], split_once);
+                  mode, lone[0], split_once);
+            for (int t = 1; t <= 4; t++) {
+                double centre = mode ? 64.0 : t < 4 ? 63.0 : 82.0; /* the last: no right one */
+                CHECK(fabs(film[4 * pixels[t]] - (1.0 - centre / 256.0)) < 1e-6,
+                      "reconstruct %d, a row of pixels split once: pixel %d's centre sample "
+                      "weighs %.2f cells, not %.0f",
+                      mode, t, 256.0 * (1.0 - film[4 * pixels[t]]), centre);
+            }
         }
-        for (int i = 0; i < 5; i++) clReleaseMemObject(m[i]);
+        for (int i = 0; i < 6; i++) clReleaseMemObject(m[i]);
     }
     fixture_close(&fx);
 }

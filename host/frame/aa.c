@@ -3,7 +3,8 @@
  * compacts them into one list; the list is traced in full batches of three new samples
  * per marked node (aa_split_rays, the frame's tracing kernels, aa_split_store), and this
  * repeats until nothing is marked; aa_resolve then makes each refined pixel the mean of
- * its finest cells, each the value of the nearest sample (or of its leaf). Uniform
+ * its finest cells, each the value of the nearest sample, its own or a refined
+ * neighbour's (or of its leaf). Uniform
  * supersampling (--ssaa) traces N x N samples of every pixel. */
 #include "aa.h"
 
@@ -202,9 +203,9 @@ static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, u
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
     pass->entries = slots;
-    const cl_mem args[5] = {aa->pass, aa->slot_pixels, aa->tree, aa->film, aa->info};
+    const cl_mem args[6] = {aa->pass, aa->slot_pixels, aa->tree, aa->film, aa->info, aa->slots};
     if (slots && (aa_write_pass(aa, r, pass) ||
-                  aa_launch(r, r->k_aa_resolve, 0, args, 5, slots, &st->aa_reconstruct_ms)))
+                  aa_launch(r, r->k_aa_resolve, 0, args, 6, slots, &st->aa_reconstruct_ms)))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
