@@ -399,18 +399,20 @@ __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const flo
         marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
         return;
     }
-    for (int k = 0; k < VBCL_AA_CELLS; k++) {
-        float4 c = vload4((size_t)slot * VBCL_AA_CELLS + (size_t)k, tree);
-        int lv = (int)c.w, s = AA_TREE_SIDE >> lv;
-        int fx = k % AA_TREE_SIDE, fy = k / AA_TREE_SIDE;
-        if (lv >= aa->max_level || fx % s || fy % s) continue; /* not a leaf's first cell */
-        if (!aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE + fx, y * AA_TREE_SIDE + fy, s,
-                           lv, aa_display(aa, c.xyz)))
-            continue;
-        uint m = atomic_inc(&counts[0]);
-        atomic_inc(&counts[1 + lv]);
-        marks[m] = (uint2)((uint)p, aa_node_code(lv, fx / s, fy / s));
-    }
+    for (int fy = 0; fy < AA_TREE_SIDE; fy++) /* each row one leaf at a time */
+        for (int fx = 0; fx < AA_TREE_SIDE;) {
+            float4 c =
+                vload4((size_t)slot * VBCL_AA_CELLS + (size_t)(fy * AA_TREE_SIDE + fx), tree);
+            int lv = (int)c.w, s = AA_TREE_SIDE >> lv, at = fx;
+            fx += s;
+            if (lv >= aa->max_level || fy % s) continue; /* not the leaf's first row */
+            if (!aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE + at, y * AA_TREE_SIDE + fy,
+                               s, lv, aa_display(aa, c.xyz)))
+                continue;
+            uint m = atomic_inc(&counts[0]);
+            atomic_inc(&counts[1 + lv]);
+            marks[m] = (uint2)((uint)p, aa_node_code(lv, at / s, fy / s));
+        }
 }
 
 /* frame, marks -> rays: three rays per marked node of a batch, through the samples of the
