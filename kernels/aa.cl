@@ -204,15 +204,15 @@ VB_INLINE int aa_band_list(__global const float *cells, int dx, int dy, uint *le
                             leaf, n, &deepest);
 }
 
-/* The squared distance in half-cells from a cell's centre (cx, cy) to the sample of leaf
- * code l (aa_leaf_list): an exact integer. */
+/* The squared distance in half-cells from a cell's centre (cx, cy) to the sample
+ * coded l (aa_sample_code): an exact integer. */
 VB_INLINE int aa_sample_d2(uint l, int cx, int cy)
 {
     int dx = (int)(l & 255u) - cx, dy = (int)(l >> 8 & 255u) - cy;
     return dx * dx + dy * dy;
 }
 
-/* Whether the sample of leaf code l (aa_leaf_list) is at least as near as the sample at
+/* Whether the sample coded l (aa_sample_code) is at least as near as the sample at
  * (hx, hy) to some cell centre of the rectangle lx .. hx2, ly .. hy2 (half-cells): the
  * cells where it is, d^2(l, c) - d^2(h, c) <= 0, lie on one side of a straight line (the
  * difference is linear in c), so the rectangle's corner that minimises it decides. Exact:
