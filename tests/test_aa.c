@@ -773,10 +773,10 @@ static void test_aa_resolve_nearest_samples(void)
             for (int t = 0; t < TREES; t++) {
                 int px = pixels[t] % RES_W, py = pixels[t] / RES_W;
                 double want = 0.0, own = 0.0;
+                int lone[NPIX]; /* the pixel's tree alone: its own samples' reconstruction */
+                for (int q = 0; q < NPIX; q++) lone[q] = q == pixels[t] ? t : -1;
                 for (int k = 0; k < VBCL_AA_CELLS; k++) {
                     int cx = 2 * (k % AA_TREE_SIDE) + 1, cy = 2 * (k / AA_TREE_SIDE) + 1;
-                    int lone[NPIX];
-                    for (int q = 0; q < NPIX; q++) lone[q] = q == pixels[t] ? t : -1;
                     if (mode) {
                         for (int i = 0; i < nleaves[t]; i++) {
                             unsigned c = leaves[t][i];

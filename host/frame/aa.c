@@ -4,8 +4,8 @@
  * per marked node (aa_split_rays, the frame's tracing kernels, aa_split_store), and this
  * repeats until nothing is marked; aa_resolve then makes each refined pixel the mean of
  * its finest cells, each the value of the nearest sample, its own or a refined
- * neighbour's (or of its leaf). Uniform
- * supersampling (--ssaa) traces N x N samples of every pixel. */
+ * neighbour's (or of its leaf). Uniform supersampling (--ssaa) traces N x N samples of
+ * every pixel. */
 #include "aa.h"
 
 #include <math.h>
