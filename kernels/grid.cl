@@ -213,18 +213,6 @@ VB_INLINE void closest_test(const RayShear *rs, float3 org, float tmax,
         closest_offer(org, tmax, tris, tri, t, u, v, c);
 }
 
-/* Whether triangle tri lies on the ray before tmax (not when its tag has a bit of `skip`,
- * VBCL_TAG_TEXTURE or 0); counts the test in *tests. */
-VB_INLINE int any_test(const RayShear *rs, float tmax, __global const VbTriangle *tris, int tri,
-                       uint skip, uint *tests)
-{
-    if (skip != 0u && (tri_tag(tris, tri) & skip) != 0u) return 0;
-    float t, u, v;
-    (*tests)++;
-    return tri_intersect(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
-                         tri_vertex(tris, tri, 2), tmax, &t, &u, &v);
-}
-
 /* Coordinate k (0, 1, 2: x, y, z) of four points, one per lane. */
 VB_INLINE float4 vb_comp4(float4 x, float4 y, float4 z, uint k)
 {
@@ -337,15 +325,24 @@ VB_INLINE uint quad_closest(const RayShear *rs, float3 org, float tmax,
     return vb_count4(real);
 }
 
-/* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit,
- * quad by quad (quad_closest), updating *c. Returns the number of triangles tested. */
+/* Tests the triangles of quads begin .. end - 1 for the closest hit, quad by quad
+ * (quad_closest), updating *c. Returns the number of triangles tested. */
+VB_INLINE uint quads_closest(const RayShear *rs, float3 org, float tmax,
+                             __global const VbTriangle *tris, __global const VbLeafQuad *quads,
+                             uint begin, uint end, Closest *c)
+{
+    uint n = 0;
+    for (uint k = begin; k < end; k++) n += quad_closest(rs, org, tmax, tris, quads + k, c);
+    return n;
+}
+
+/* Tests the triangles of one leaf (a sub-cell or a top cell's list) for the closest hit
+ * (quads_closest), updating *c. Returns the number of triangles tested. */
 VB_INLINE uint grid_leaf_closest(const RayShear *rs, float3 org, float tmax,
                                  __global const VbTriangle *tris, __global const uint *leaf_start,
                                  __global const VbLeafQuad *quads, uint leaf, Closest *c)
 {
-    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1], n = 0;
-    for (uint k = begin; k < end; k++) n += quad_closest(rs, org, tmax, tris, quads + k, c);
-    return n;
+    return quads_closest(rs, org, tmax, tris, quads, leaf_start[leaf], leaf_start[leaf + 1], c);
 }
 
 /* The closest-hit search *cp (hits with 0 < t <= tmax) carried on through the cells that
@@ -406,18 +403,17 @@ VB_INLINE VbHit grid_trace_closest(__constant const VbGrid *g, __global const Vb
     return c.hit;
 }
 
-/* Whether any triangle of one leaf lies on the ray before tmax, those whose tag has a bit
- * of `skip` (VBCL_TAG_TEXTURE or 0) not counted; adds the tests to *tests (a quad's real
- * lanes; a skipped texture quad none). */
-VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
-                            __global const uint *leaf_start, __global const VbLeafQuad *quads,
-                            uint leaf, uint skip, uint *tests)
+/* Whether any triangle of quads begin .. end - 1 lies on the ray before tmax, those whose
+ * tag has a bit of `skip` (VBCL_TAG_TEXTURE or 0) not counted; adds the tests to *tests (a
+ * quad's real lanes; a skipped texture quad none). */
+VB_INLINE int quads_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
+                        __global const VbLeafQuad *quads, uint begin, uint end, uint skip,
+                        uint *tests)
 {
-    uint begin = leaf_start[leaf], end = leaf_start[leaf + 1];
     for (uint k = begin; k < end; k++) {
         __global const VbLeafQuad *q = quads + k;
         int4 id = quad_ids(q);
-        /* the real lanes of a quad share VBCL_TAG_TEXTURE (pack_leaf_quads), lane 0 is real */
+        /* the real lanes of a quad share VBCL_TAG_TEXTURE (pack_quads), lane 0 is real */
         if ((skip & tri_tag(tris, id.s0) & VBCL_TAG_TEXTURE) != 0u) continue;
         int4 real = id >= 0;
         *tests += vb_count4(real);
@@ -431,6 +427,14 @@ VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTri
             return 1;
     }
     return 0;
+}
+
+/* quads_any over the quads of one leaf. */
+VB_INLINE int grid_leaf_any(const RayShear *rs, float tmax, __global const VbTriangle *tris,
+                            __global const uint *leaf_start, __global const VbLeafQuad *quads,
+                            uint leaf, uint skip, uint *tests)
+{
+    return quads_any(rs, tmax, tris, quads, leaf_start[leaf], leaf_start[leaf + 1], skip, tests);
 }
 
 /* Returns 1 when anything lies on the ray (org, dir) with 0 < t < tmax (a shadow

@@ -229,14 +229,15 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
 /* The triangles that feelers from ls->origin toward the light sphere (radius r, 0 for a
  * point light) may meet (VBCL_FRAME_CONE_TEST; the host sets it for scenes of at most
  * VBCL_CONE_TEST_MAX_OBJECTS objects): none, so that no feeler need be traced; a few
- * (at most VB_OBJECT_SET_MAX ranges of VB_OBJECT_SET_MAX_TRIS triangles in all), which alone
- * each feeler then tests, without walking the grid; or n = -1, the grid (too many, or the
+ * (at most VB_OBJECT_SET_MAX ranges of VBCL_OBJECT_SET_MAX_TRIS triangles in all, held four
+ * at a time in the records' quads: VbObject.quad_tri, quad_tex), which alone each feeler
+ * then tests, without walking the grid; or n = -1, the grid (too many, or the
  * test off). Every feeler lies in the cone from the origin around the direction to the
  * light's centre, of half-angle theta with sin theta = r / d, and ends before distance d;
  * an object can stop one only if the cone meets its bounds (light_cone_meets). Where it
  * does, its own triangles are taken, and of its texture only the parts (connected pieces,
  * VbObject.first_elem) whose own bounds the cone meets; an object or part of more than
- * VB_OBJECT_SET_MAX_TRIS / 2 triangles is kept aside as big instead (a glass ball of
+ * VBCL_OBJECT_SET_MAX_TRIS / 2 triangles is kept aside as big instead (a glass ball of
  * thousands of triangles: only the feelers that meet its bounding sphere walk the grid). The
  * point's own object cannot stop a feeler when it is planar (a feeler is traced only toward the
  * side of the surface it leaves from), nor when it is convex and the feeler leaves from the front
@@ -277,13 +278,13 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
                          (flags & (VBCL_OBJECT_CONVEX | VBCL_OBJECT_HULL))
                      ? (int)i
                      : -2;
-        if (ob->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
+        if (ob->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
             if (!object_set_big(os, i)) return;
             continue;
         }
-        if (!object_set_add(os, ob->first_tri, ob->ntris)) return;
+        if (!object_set_add(os, ob->quad_tri, ob->ntris)) return;
         if (ob->nelems == 0u) {
-            if (!object_set_add(os, ob->first_tex, ob->ntex)) return;
+            if (!object_set_add(os, ob->quad_tex, ob->ntex)) return;
             continue;
         }
         for (uint e = 0; e < ob->nelems; e++) {
@@ -291,9 +292,9 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             if (tri - el->first_tri < el->ntris && (el->flags & VBCL_OBJECT_CONVEX) && sp->front)
                 continue;
             if (!light_cone_meets(&k, el)) continue;
-            if (el->ntris > VB_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
+            if (el->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
                 if (!object_set_big(os, ob->first_elem + e)) return;
-            } else if (!object_set_add(os, el->first_tri, el->ntris)) {
+            } else if (!object_set_add(os, el->quad_tri, el->ntris)) {
                 return;
             }
         }

@@ -99,13 +99,13 @@ VB_INLINE int scene_trace_any(const DevScene *sc, float3 org, float3 dir, float 
 /* A few ranges of triangles, the only ones a ray may meet (the shadow cone test,
  * light.cl, has shown the rest of the scene to be out of its way), or n < 0: any
  * triangle (the grid). */
-#define VB_OBJECT_SET_MAX      4  /* ranges */
-#define VB_OBJECT_SET_MAX_TRIS 32 /* triangles in all */
-#define VB_OBJECT_SET_MAX_BIG  4  /* parts too big for the set, each feeler tests their bounds */
+#define VB_OBJECT_SET_MAX     4 /* ranges */
+#define VB_OBJECT_SET_MAX_BIG 4 /* parts too big for the set, each feeler tests their bounds */
 typedef struct ObjectSet {
     int n;
-    uint tris; /* triangles in all */
-    uint first[VB_OBJECT_SET_MAX], count[VB_OBJECT_SET_MAX];
+    uint tris;                     /* triangles in all, at most VBCL_OBJECT_SET_MAX_TRIS */
+    uint first[VB_OBJECT_SET_MAX]; /* a range's first quad in leaf_quads (VbObject.quad_tri) */
+    uint count[VB_OBJECT_SET_MAX]; /* its triangles, ceil(count / 4) quads */
     int nbig; /* records (VbObject: objects of many triangles, their textures included, and
                * texture parts) of big: a feeler that meets the bounding sphere of one of
                * them walks the grid, the others test the ranges alone */
@@ -272,13 +272,14 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
     return need;
 }
 
-/* Adds triangles first .. first + count - 1 to the set; 0 where the set is full (n = -1:
- * the grid from then on). */
+/* Adds the count triangles held by the quads from leaf_quads[first] on (a record's range:
+ * VbObject.quad_tri or quad_tex) to the set; 0 where the set is full (n = -1: the grid from
+ * then on). */
 VB_INLINE int object_set_add(ObjectSet *os, uint first, uint count)
 {
     if (count == 0u) return 1;
     os->tris += count;
-    if (os->n == VB_OBJECT_SET_MAX || os->tris > VB_OBJECT_SET_MAX_TRIS) {
+    if (os->n == VB_OBJECT_SET_MAX || os->tris > VBCL_OBJECT_SET_MAX_TRIS) {
         os->n = -1;
         return 0;
     }
@@ -299,10 +300,16 @@ VB_INLINE int object_set_big(ObjectSet *os, uint rec)
     return 1;
 }
 
-/* scene_trace_closest among the set's triangles alone: each of them tested (the
- * same test and the same order of hits as the grid's, ties to the lower index), and with
- * os->walk the grid over object_set_span, which finds the big records' triangles (and the
- * ranges' again, which changes nothing). */
+/* The quad after the last of range k of a set. */
+VB_INLINE uint object_set_end(const ObjectSet *os, int k)
+{
+    return os->first[k] + (os->count[k] + 3u) / 4u;
+}
+
+/* scene_trace_closest among the set's triangles alone: each of them tested, four at a time
+ * as in the grid's leaves (the same test and the same order of hits as the grid's, ties to
+ * the lower index), and with os->walk the grid over object_set_span, which finds the big
+ * records' triangles (and the ranges' again, which changes nothing). */
 VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, float3 org,
                                        float3 dir, float tmax, TraceCount *tc)
 {
@@ -310,11 +317,9 @@ VB_INLINE VbHit scene_trace_closest_in(const DevScene *sc, const ObjectSet *os, 
     Closest c;
     closest_begin(&c, tmax);
     RayShear rs = ray_shear_make(org, dir);
-    for (int k = 0; k < os->n; k++) {
-        for (uint t = os->first[k]; t < os->first[k] + os->count[k]; t++)
-            closest_test(&rs, org, tmax, sc->tris, (int)t, &c);
-        tc->tests += os->count[k];
-    }
+    for (int k = 0; k < os->n; k++)
+        tc->tests += quads_closest(&rs, org, tmax, sc->tris, sc->leaf_quads, os->first[k],
+                                   object_set_end(os, k), &c);
     if (os->walk) {
         float2 span = object_set_span(sc, os, org, dir, tmax);
         if (span.x <= span.y)
@@ -332,8 +337,9 @@ VB_INLINE int scene_trace_any_in(const DevScene *sc, const ObjectSet *os, float3
     if (os->n < 0) return scene_trace_any(sc, org, dir, tmax, skip, tc);
     RayShear rs = ray_shear_make(org, dir);
     for (int k = 0; k < os->n; k++)
-        for (uint t = os->first[k]; t < os->first[k] + os->count[k]; t++)
-            if (any_test(&rs, tmax, sc->tris, (int)t, skip, &tc->tests)) return 1;
+        if (quads_any(&rs, tmax, sc->tris, sc->leaf_quads, os->first[k], object_set_end(os, k),
+                      skip, &tc->tests))
+            return 1;
     if (!os->walk) return 0;
     float2 span = object_set_span(sc, os, org, dir, tmax);
     return span.x <= span.y &&

@@ -173,8 +173,19 @@ typedef struct VbObject {
     float own[4]; /* a sphere holding the object's own triangles alone, its texture left out
                    * (as bound: centre, radius with margins; radius < 0: none); a part's and a
                    * textureless object's is bound */
-    unsigned int pad2[2];
+    unsigned int quad_tri; /* the first of the quads (VbLeafQuad, after the leaves' in
+                            * leaf_quads) that hold its own triangles four at a time, in the
+                            * order of their indices, for the shadow cone test's sets
+                            * (light_cone_objects); VBCL_NO_QUADS where it has more than
+                            * VBCL_OBJECT_SET_MAX_TRIS / 2 (a set never holds them) */
+    unsigned int quad_tex; /* the same for its texture's triangles, where it has no parts
+                            * (nelems 0) and at most VBCL_OBJECT_SET_MAX_TRIS of them */
 } VbObject;
+
+/* The shadow cone test's sets of triangles (kernels/scene.cl, ObjectSet): at most this many
+ * triangles in all; a record of more than half of it is tested by its bounds instead. */
+#define VBCL_OBJECT_SET_MAX_TRIS 32
+#define VBCL_NO_QUADS            0xffffffffu
 
 /* Where a ray is: inside which host (or none), and inside how many elements of each
  * textured object's texture (8 bits per slot). The effective material follows. */
@@ -232,8 +243,9 @@ typedef struct VbGridCell {
  * quad_candidates): xyz[3 k + a] holds coordinate a (x, y, z) of vertex k of the four
  * triangles, tri their indices. A leaf's scene triangles and its texture triangles fill
  * quads of their own (ceil(n / 4) each, in ascending triangle order), the last of each
- * padded with tri -1 (and zero vertices). Written by pack_leaf_quads
- * (host/device/device_scene.c), counted by grid_leaf_quads (host/accel/grid.c). */
+ * padded with tri -1 (and zero vertices). After the leaves' come those of the records'
+ * small ranges (VbObject.quad_tri, quad_tex), in the same way. Written by pack_quads
+ * (host/device/device_scene.c); the leaves' counted by grid_leaf_quads (host/accel/grid.c). */
 typedef struct VbLeafQuad {
     float xyz[9][4];
     int tri[4];
@@ -344,7 +356,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
-    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -385,6 +397,8 @@ VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
 VBCL_STATIC_ASSERT(sizeof(VbObject) == 128, object_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, own) == 104, object_own);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tri) == 120, object_quad_tri);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tex) == 124, object_quad_tex);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, nelems) == 100, object_nelems);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, first_tri) == 80, object_first_tri);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ntex) == 92, object_ntex);

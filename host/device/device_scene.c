@@ -68,15 +68,60 @@ static VbTriangle *pack_triangles(const Scene *s)
     return t;
 }
 
-/* The leaves' triangles four at a time (VbLeafQuad, kernels/types.h): leaf l's quads are
- * quads[start[l] .. start[l + 1] - 1], first those of its scene triangles and then those of
- * its texture triangles, each in the order of g->leaf_tris, a kind's last quad padded with
- * tri -1, so that all real lanes of a quad share VBCL_TAG_TEXTURE. Returns the quads (NULL:
- * out of memory; *start too) and their number in *nquads. */
-static VbLeafQuad *pack_leaf_quads(const Grid *g, const uint32_t *tri_tag, const VbTriangle *tris,
-                                   uint32_t **start, uint32_t *nquads)
+/* Appends triangle t to the quads being packed: lane *lane of quad *k, or lane 0 of the
+ * next quad (its lanes padded with tri -1) where that one is full. */
+static void quad_put(VbLeafQuad *q, size_t *k, uint32_t *lane, const VbTriangle *tris, uint32_t t)
 {
-    size_t n = grid_leaf_quads(g, tri_tag, VBCL_TAG_TEXTURE);
+    if (*lane == 4) {
+        *lane = 0;
+        (*k)++;
+    }
+    if (*lane == 0)
+        for (int j = 0; j < 4; j++) q[*k].tri[j] = -1;
+    const float *v[3] = {tris[t].v0, tris[t].v1, tris[t].v2};
+    for (int a = 0; a < 9; a++) q[*k].xyz[a][*lane] = v[a / 3][a % 3];
+    q[*k].tri[(*lane)++] = (int)t;
+}
+
+/* Ends a run of quad_put: the quad in progress is done. */
+static void quad_end(size_t *k, uint32_t *lane)
+{
+    if (*lane > 0) (*k)++;
+    *lane = 0;
+}
+
+/* The quads of record o's own triangles (tex 0) or of its texture's (tex 1) for the shadow
+ * cone test's sets: the ranges light_cone_objects may add to one (a record of at most
+ * VBCL_OBJECT_SET_MAX_TRIS / 2 triangles; a texture without parts of at most
+ * VBCL_OBJECT_SET_MAX_TRIS), else 0. */
+static uint32_t object_range_quads(const VbObject *o, int tex)
+{
+    uint32_t n = tex ? o->ntex : o->ntris;
+    int fits =
+        tex ? o->nelems == 0u && n <= VBCL_OBJECT_SET_MAX_TRIS : n <= VBCL_OBJECT_SET_MAX_TRIS / 2;
+    return fits ? (n + 3u) / 4u : 0u;
+}
+
+/* How many quads the records' ranges take (object_range_quads). */
+static size_t objects_quads(const VbObject *objs, size_t nobjs)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < nobjs; i++)
+        n += object_range_quads(&objs[i], 0) + object_range_quads(&objs[i], 1);
+    return n;
+}
+
+/* The triangles four at a time (VbLeafQuad, kernels/types.h). First the leaves': leaf l's
+ * quads are quads[start[l] .. start[l + 1] - 1], first those of its scene triangles and
+ * then those of its texture triangles, each in the order of g->leaf_tris, a kind's last quad
+ * padded with tri -1, so that all real lanes of a quad share VBCL_TAG_TEXTURE. Then the
+ * records' ranges (object_range_quads), each in the order of its triangles, whose first
+ * quads go into the records (quad_tri, quad_tex; VBCL_NO_QUADS: none). Returns the quads
+ * (NULL: out of memory; *start too) and their number in *nquads. */
+static VbLeafQuad *pack_quads(const Grid *g, const uint32_t *tri_tag, const VbTriangle *tris,
+                              VbObject *objs, size_t nobjs, uint32_t **start, uint32_t *nquads)
+{
+    size_t n = grid_leaf_quads(g, tri_tag, VBCL_TAG_TEXTURE) + objects_quads(objs, nobjs);
     *nquads = (uint32_t)n;
     *start = malloc(sizeof **start * ((size_t)g->nleaves + 1));
     VbLeafQuad *q = calloc(n ? n : 1, sizeof *q);
@@ -87,27 +132,31 @@ static VbLeafQuad *pack_leaf_quads(const Grid *g, const uint32_t *tri_tag, const
         return NULL;
     }
     size_t k = 0;
+    uint32_t lane = 0;
     for (uint32_t l = 0; l < g->nleaves; l++) {
         (*start)[l] = (uint32_t)k;
         for (int texture = 0; texture < 2; texture++) {
-            uint32_t lane = 0;
             for (uint32_t i = g->leaf_start[l]; i < g->leaf_start[l + 1]; i++) {
                 uint32_t t = g->leaf_tris[i];
-                if (((tri_tag[t] & VBCL_TAG_TEXTURE) != 0u) != texture) continue;
-                if (lane == 4) {
-                    lane = 0;
-                    k++;
-                }
-                if (lane == 0)
-                    for (int j = 0; j < 4; j++) q[k].tri[j] = -1;
-                const float *v[3] = {tris[t].v0, tris[t].v1, tris[t].v2};
-                for (int a = 0; a < 9; a++) q[k].xyz[a][lane] = v[a / 3][a % 3];
-                q[k].tri[lane++] = (int)t;
+                if (((tri_tag[t] & VBCL_TAG_TEXTURE) != 0u) == texture)
+                    quad_put(q, &k, &lane, tris, t);
             }
-            if (lane > 0) k++;
+            quad_end(&k, &lane);
         }
     }
     (*start)[g->nleaves] = (uint32_t)k;
+    for (size_t i = 0; i < nobjs; i++) {
+        VbObject *o = &objs[i];
+        for (int tex = 0; tex < 2; tex++) {
+            uint32_t first = tex ? o->first_tex : o->first_tri, count = tex ? o->ntex : o->ntris;
+            uint32_t *dst = tex ? &o->quad_tex : &o->quad_tri;
+            *dst = VBCL_NO_QUADS;
+            if (object_range_quads(o, tex) == 0u) continue;
+            *dst = (uint32_t)k;
+            for (uint32_t t = first; t < first + count; t++) quad_put(q, &k, &lane, tris, t);
+            quad_end(&k, &lane);
+        }
+    }
     return q;
 }
 
@@ -299,14 +348,19 @@ static int upload_camera_tiles(SceneBuffers *b, VbDevice *dev, const Scene *s,
     return 1;
 }
 
-/* Triangles, smooth normals (with VBCL_FEATURE_SMOOTH_NORMALS), grid cells and the camera
- * tiles (into ct). Returns 0, 1 (out of memory, device) or 2 (larger than one allocation). */
+/* Triangles, smooth normals (with VBCL_FEATURE_SMOOTH_NORMALS), grid cells, the quads of
+ * the leaves and of the records objs (whose quad_tri and quad_tex it sets: pack_quads) and
+ * the camera tiles (into ct). Returns 0, 1 (out of memory, device) or 2 (larger than one
+ * allocation). */
 static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const Grid *g,
-                           unsigned features, VbCamTiles *ct, char *err, size_t errlen)
+                           VbObject *objs, size_t nobjs, unsigned features, VbCamTiles *ct,
+                           char *err, size_t errlen)
 {
     size_t nbytes_tris = sizeof(VbTriangle) * s->mesh.ntris;
     if (nbytes_tris > dev->max_alloc ||
-        sizeof(VbLeafQuad) * grid_leaf_quads(g, s->tri_tag, VBCL_TAG_TEXTURE) > dev->max_alloc ||
+        sizeof(VbLeafQuad) *
+                (grid_leaf_quads(g, s->tri_tag, VBCL_TAG_TEXTURE) + objects_quads(objs, nobjs)) >
+            dev->max_alloc ||
         sizeof(uint32_t) * ((size_t)g->nleaves + 1) > dev->max_alloc) {
         snprintf(err, errlen,
                  "%s: the scene (%u triangles, %u grid references in %u leaves) does not fit "
@@ -318,7 +372,8 @@ static int upload_geometry(SceneBuffers *b, VbDevice *dev, const Scene *s, const
     VbTriangle *tris = pack_triangles(s);
     VbTriNormals *normals = pack_normals(s);
     uint32_t *quad_start = NULL, nquads = 0;
-    VbLeafQuad *quads = tris ? pack_leaf_quads(g, s->tri_tag, tris, &quad_start, &nquads) : NULL;
+    VbLeafQuad *quads =
+        tris ? pack_quads(g, s->tri_tag, tris, objs, nobjs, &quad_start, &nquads) : NULL;
     if (!tris || !normals || !quads) {
         free(tris);
         free(normals);
@@ -697,16 +752,16 @@ fail:
 }
 
 /* Materials (the scene's, then the medium outside every host: vacuum, eta 1), their
- * patterns and band tables, objects and lights. Returns as upload_patterns. */
-static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsigned features,
-                            unsigned *band_weights, char *err, size_t errlen)
+ * patterns and band tables, the nobjs records objs (objects_make) and lights. Returns as
+ * upload_patterns. */
+static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, const VbObject *objs,
+                            size_t nobjs, unsigned features, unsigned *band_weights, char *err,
+                            size_t errlen)
 {
     VbMaterial *mats = calloc((size_t)s->nmaterials + 1, sizeof *mats);
-    size_t nobjs = 0;
-    VbObject *objs = objects_make(s, &nobjs);
     int rc = 1;
     snprintf(err, errlen, "out of memory");
-    if (!mats || !objs) goto done;
+    if (!mats) goto done;
     for (int i = 0; i < s->nmaterials; i++) mats[i] = s->materials[i].gpu;
     mats[s->nmaterials].eta = 1.0f;
     mats[s->nmaterials].pattern = -1;
@@ -722,7 +777,6 @@ static int upload_materials(SceneBuffers *b, VbDevice *dev, const Scene *s, unsi
     if (rc) snprintf(err, errlen, "%s: %s", dev->name, clu_error());
 done:
     free(mats);
-    free(objs);
     return rc;
 }
 
@@ -768,8 +822,15 @@ int scene_buffers_upload(SceneBuffers *b, VbDevice *dev, const Scene *s, const G
     memset(b, 0, sizeof *b);
     unsigned band_weights = 0;
     VbCamTiles ct;
-    int rc = upload_geometry(b, dev, s, g, features, &ct, err, errlen);
-    if (!rc) rc = upload_materials(b, dev, s, features, &band_weights, err, errlen);
+    size_t nobjs = 0;
+    VbObject *objs = objects_make(s, &nobjs);
+    if (!objs) {
+        snprintf(err, errlen, "out of memory");
+        return 1;
+    }
+    int rc = upload_geometry(b, dev, s, g, objs, nobjs, features, &ct, err, errlen);
+    if (!rc) rc = upload_materials(b, dev, s, objs, nobjs, features, &band_weights, err, errlen);
+    free(objs);
     if (rc) return rc;
     frame_fill(s, g, band_weights, f);
     f->cam_tiles = ct;
