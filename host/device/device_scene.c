@@ -116,7 +116,9 @@ static size_t objects_quads(const VbObject *objs, size_t nobjs)
  * then those of its texture triangles, each in the order of g->leaf_tris, a kind's last quad
  * padded with tri -1, so that all real lanes of a quad share VBCL_TAG_TEXTURE. Then the
  * records' ranges (object_range_quads), each in the order of its triangles, whose first
- * quads go into the records (quad_tri, quad_tex; VBCL_NO_QUADS: none). Returns the quads
+ * quads go into the records (quad_tri, quad_tex; VBCL_NO_QUADS: none); a range is of one
+ * kind (an object's own triangles, or texture ones), so its quads share the tag too (which
+ * quads_any reads from lane 0). Returns the quads
  * (NULL: out of memory; *start too) and their number in *nquads. */
 static VbLeafQuad *pack_quads(const Grid *g, const uint32_t *tri_tag, const VbTriangle *tris,
                               VbObject *objs, size_t nobjs, uint32_t **start, uint32_t *nquads)
