@@ -179,7 +179,7 @@ typedef struct VbObject {
                             * (light_cone_objects); VBCL_NO_QUADS where it has more than
                             * VBCL_OBJECT_SET_MAX_TRIS / 2 (a set never holds them) */
     unsigned int quad_tex; /* the same for its texture's triangles, where it has no parts
-                            * (nelems 0) and at most VBCL_OBJECT_SET_MAX_TRIS of them */
+                            * (nelems 0) and they and its own fit in a set together */
 } VbObject;
 
 /* The shadow cone test's sets of triangles (kernels/scene.cl, ObjectSet): at most this many

@@ -92,14 +92,13 @@ static void quad_end(size_t *k, uint32_t *lane)
 
 /* The quads of record o's own triangles (tex 0) or of its texture's (tex 1) for the shadow
  * cone test's sets: the ranges light_cone_objects may add to one (a record of at most
- * VBCL_OBJECT_SET_MAX_TRIS / 2 triangles; a texture without parts of at most
- * VBCL_OBJECT_SET_MAX_TRIS), else 0. */
+ * VBCL_OBJECT_SET_MAX_TRIS / 2 triangles; with its texture, where that has no parts, if
+ * the two together fit in a set), else 0. */
 static uint32_t object_range_quads(const VbObject *o, int tex)
 {
-    uint32_t n = tex ? o->ntex : o->ntris;
-    int fits =
-        tex ? o->nelems == 0u && n <= VBCL_OBJECT_SET_MAX_TRIS : n <= VBCL_OBJECT_SET_MAX_TRIS / 2;
-    return fits ? (n + 3u) / 4u : 0u;
+    int own = o->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2;
+    int fits = tex ? own && o->nelems == 0u && o->ntris + o->ntex <= VBCL_OBJECT_SET_MAX_TRIS : own;
+    return fits ? ((tex ? o->ntex : o->ntris) + 3u) / 4u : 0u;
 }
 
 /* How many quads the records' ranges take (object_range_quads). */
