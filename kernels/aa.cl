@@ -4,11 +4,11 @@
  * positions and ids, and the tree's storage. The entry points are in render.cl.
  *
  * Storage: a pixel nobody refined is its film value (level 0). A refined pixel owns a tree
- * slot of 256 float4 finest cells; each cell holds the value of the leaf that covers it
- * (rgb) and that leaf's level (w). A leaf at level L covers 4^(4-L) cells, so the
- * area-weighted mean of the leaves is the plain mean of the cells; the default
- * reconstruction instead weighs each sample, the pixel's own or a refined neighbour's, by
- * the pixel's cells nearest to it (aa_nearest_weights). */
+ * slot (aa_tree.h): the level of the leaf covering each of its 256 finest cells, one byte
+ * each, and the value of each node's sample, level by level. A leaf at level L covers
+ * 4^(4-L) cells, so the area-weighted mean of the leaves is the plain mean of the cells'
+ * leaves; the default reconstruction instead weighs each sample, the pixel's own or a
+ * refined neighbour's, by the pixel's cells nearest to it (aa_nearest_weights). */
 #ifndef VBCL_AA_CL
 #define VBCL_AA_CL
 
@@ -32,17 +32,26 @@ VB_INLINE int aa_contrast_fails(float3 a, float3 b, float threshold, float floor
     return d.x > threshold * s.x || d.y > threshold * s.y || d.z > threshold * s.z;
 }
 
-/* The leaf covering finest cell (X, Y) of the image (16 cells per pixel axis): its value
- * (rgb, raw) and level (w). */
-VB_INLINE float4 aa_leaf_at(__constant const VbAaPass *aa, __global const float *film,
-                            __global const int *slots, __global const float *tree, int X, int Y)
+/* The trees of the refined pixels (aa_tree.h): levels and values of cap slots. */
+typedef struct AaTree {
+    __global const uchar *levels; /* 256 per slot: the level of the leaf covering each cell */
+    __global const float *values; /* a float4 per node, level by level (aa_level_base) */
+    uint cap;
+} AaTree;
+
+/* The index (in float4) of the value of node (x, y) at level lv (1 .. 4) of a tree slot. */
+VB_INLINE size_t aa_node_value(uint cap, int slot, int lv, int x, int y)
 {
-    int q = (Y / AA_TREE_SIDE) * aa->width + X / AA_TREE_SIDE;
-    int slot = slots[q];
-    if (slot < 0) return (float4)(vload4(q, film).xyz, 0.0f);
-    return vload4((size_t)slot * VBCL_AA_CELLS +
-                      (size_t)((Y % AA_TREE_SIDE) * AA_TREE_SIDE + X % AA_TREE_SIDE),
-                  tree);
+    return (size_t)cap * (size_t)aa_level_base(lv) + ((size_t)slot << (2 * lv)) +
+           (size_t)((y << lv) + x);
+}
+
+/* The index (in float4) of the value of the leaf at level lv covering finest cell (fx, fy)
+ * of a tree slot. */
+VB_INLINE size_t aa_cell_value(uint cap, int slot, int lv, int fx, int fy)
+{
+    int shift = VBCL_AA_MAX_LEVEL - lv;
+    return aa_node_value(cap, slot, lv, fx >> shift, fy >> shift);
 }
 
 /* Whether the leaf of s x s cells at (X0, Y0) (image cells), level lv, display value a,
@@ -54,8 +63,8 @@ VB_INLINE float4 aa_leaf_at(__constant const VbAaPass *aa, __global const float 
  * (every level alike); with 2, an edge's share of its pixel's error, which halves with
  * each level (2^L leaves of 4^-L of the pixel along it), is what is held to the threshold. */
 VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float *film,
-                            __global const int *slots, __global const float *tree, int X0, int Y0,
-                            int s, int lv, float3 a)
+                            __global const int *slots, AaTree tree, int X0, int Y0, int s, int lv,
+                            float3 a)
 {
     int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE;
     float threshold = aa->threshold; /* x level_gain^lv (pown costs an exp and a log here) */
@@ -66,11 +75,18 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
         if (fixed < 0 || fixed >= (row ? H : W)) continue;
         int lo = row ? max(X0 - 1, 0) : Y0, hi = row ? min(X0 + s, W - 1) : Y0 + s - 1;
         for (int t = lo; t <= hi;) {
-            float4 c = row ? aa_leaf_at(aa, film, slots, tree, t, fixed)
-                           : aa_leaf_at(aa, film, slots, tree, fixed, t);
-            int lc = (int)c.w, sc = AA_TREE_SIDE >> lc;
-            if (lc >= lv && aa_contrast_fails(a, aa_display(aa, c.xyz), threshold, aa->floor))
-                return 1;
+            int X = row ? t : fixed, Y = row ? fixed : t;
+            int q = (Y / AA_TREE_SIDE) * aa->width + X / AA_TREE_SIDE, slot = slots[q], lc = 0;
+            int fx = X % AA_TREE_SIDE, fy = Y % AA_TREE_SIDE;
+            if (slot >= 0)
+                lc = tree.levels[(size_t)slot * VBCL_AA_CELLS + (size_t)(fy * AA_TREE_SIDE + fx)];
+            if (lc >= lv) { /* the value only of a leaf compared */
+                float3 c = slot < 0
+                               ? vload4(q, film).xyz
+                               : vload4(aa_cell_value(tree.cap, slot, lc, fx, fy), tree.values).xyz;
+                if (aa_contrast_fails(a, aa_display(aa, c), threshold, aa->floor)) return 1;
+            }
+            int sc = AA_TREE_SIDE >> lc;
             t = (t / sc + 1) * sc;
         }
     }
@@ -89,6 +105,46 @@ VB_INLINE int aa_pixel_dirty(__constant const VbAaPass *aa, __global const int *
     for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
         for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++)
             if (changed[qy * aa->width + qx] == aa->round - 1) return 1;
+    return 0;
+}
+
+/* The 4 x 4-cell blocks of a pixel (bit by * 4 + bx) that cells x0 .. x1, y0 .. y1 of it
+ * (0 .. 15, x0 <= x1, y0 <= y1) meet. */
+VB_INLINE uint aa_block_mask(int x0, int x1, int y0, int y1)
+{
+    uint cols = (0xfu >> (3 - x1 / 4)) & (0xfu << (x0 / 4)) & 0xfu;
+    uint rows = (0xffffu >> (4 * (3 - y1 / 4))) & (0xffffu << (4 * (y0 / 4))) & 0x1111u;
+    return cols * rows;
+}
+
+/* The blocks (aa_block_mask) of node `code` of a pixel. */
+VB_INLINE uint aa_node_blocks(unsigned int code)
+{
+    int s = AA_TREE_SIDE >> aa_node_level(code);
+    int x0 = aa_node_x(code) * s, y0 = aa_node_y(code) * s;
+    return aa_block_mask(x0, x0 + s - 1, y0, y0 + s - 1);
+}
+
+/* Whether the leaf of s x s cells at (X0, Y0) (image cells) needs its contrast test in a
+ * round after the first: whether it or an adjacent cell lies in a block split last round
+ * (split[q]: the blocks of pixel q split last round). Otherwise the leaf and every leaf
+ * around it are as they were when it last passed the test (each split is followed by the
+ * test of every leaf around it), so it passes again. */
+VB_INLINE int aa_leaf_touched(__constant const VbAaPass *aa, __global const uint *split, int X0,
+                              int Y0, int s)
+{
+    int W = aa->width * AA_TREE_SIDE, H = aa->height * AA_TREE_SIDE;
+    int bx0 = max(X0 - 1, 0), bx1 = min(X0 + s, W - 1), by0 = max(Y0 - 1, 0),
+        by1 = min(Y0 + s, H - 1);
+    for (int qy = by0 / AA_TREE_SIDE; qy <= by1 / AA_TREE_SIDE; qy++)
+        for (int qx = bx0 / AA_TREE_SIDE; qx <= bx1 / AA_TREE_SIDE; qx++) {
+            uint m = split[qy * aa->width + qx];
+            if (!m) continue;
+            int ox = qx * AA_TREE_SIDE, oy = qy * AA_TREE_SIDE;
+            if (m & aa_block_mask(max(bx0 - ox, 0), min(bx1 - ox, AA_TREE_SIDE - 1),
+                                  max(by0 - oy, 0), min(by1 - oy, AA_TREE_SIDE - 1)))
+                return 1;
+        }
     return 0;
 }
 
@@ -150,8 +206,8 @@ VB_INLINE uint aa_tree_sample_id(uint pixel, uint cell, int level)
 #define AA_EXT_MAX  (4 * VBCL_AA_CELLS) /* own 256; sides 4 x 128, corners 4 x 64 */
 #define AA_OWN      4u                  /* the source of the pixel's own samples */
 
-/* The code of the sample of a leaf at level lv whose sample cell is `at` (which holds the
- * leaf's value, as all its cells do) in the tree of pixel `src` (0 .. 8, row-major over the
+/* The code of the sample of a leaf at level lv whose sample cell is `at` (a cell of the
+ * leaf) in the tree of pixel `src` (0 .. 8, row-major over the
  * 3 x 3 pixels, AA_OWN the pixel itself), offset by (ox, oy) half-cells:
  * x | y << 8 | at << 16 | lv << 24 | src << 28, (x, y) the sample's position in half-cells
  * of the square around the pixel (exact: a cell's centre is odd, a pixel's centre even). */
@@ -168,12 +224,12 @@ VB_INLINE uint aa_sample_code(int at, int lv, uint src, int ox, int oy)
  * (aa_sample_code: held in the leaf's sample cell, source src, offset (ox, oy)). Each row
  * is walked one leaf at a time (the next leaf along a row starts at the next multiple of
  * the current one's size). Returns the new count; *deepest gets the deepest level. */
-VB_INLINE int aa_region_leaves(__global const float *cells, int fx0, int fx1, int fy0, int fy1,
+VB_INLINE int aa_region_leaves(__global const uchar *levels, int fx0, int fx1, int fy0, int fy1,
                                uint src, int ox, int oy, uint *leaf, int n, int *deepest)
 {
     for (int fy = fy0; fy < fy1; fy++)
         for (int fx = fx0; fx < fx1;) {
-            int lv = (int)cells[4 * (fy * AA_TREE_SIDE + fx) + 3], s = AA_TREE_SIDE >> lv;
+            int lv = levels[fy * AA_TREE_SIDE + fx], s = AA_TREE_SIDE >> lv;
             *deepest = max(*deepest, lv);
             if (fy % s == 0) {
                 int at = aa_node_sample_cell(lv, fx / s, fy / s);
@@ -185,21 +241,21 @@ VB_INLINE int aa_region_leaves(__global const float *cells, int fx0, int fx1, in
 }
 
 /* The leaves of a tree slot (aa_region_leaves over the whole pixel). */
-VB_INLINE int aa_leaf_list(__global const float *cells, uint *leaf, int *deepest)
+VB_INLINE int aa_leaf_list(__global const uchar *levels, uint *leaf, int *deepest)
 {
-    return aa_region_leaves(cells, 0, AA_TREE_SIDE, 0, AA_TREE_SIDE, AA_OWN, 2 * AA_BAND,
+    return aa_region_leaves(levels, 0, AA_TREE_SIDE, 0, AA_TREE_SIDE, AA_OWN, 2 * AA_BAND,
                             2 * AA_BAND, leaf, 0, deepest);
 }
 
 /* The samples of the tree of the adjacent pixel at (dx, dy) (each -1 .. 1) that lie in its
  * cells within AA_BAND cells of the pixel, appended to leaf from n on. Returns the new
  * count. */
-VB_INLINE int aa_band_list(__global const float *cells, int dx, int dy, uint *leaf, int n)
+VB_INLINE int aa_band_list(__global const uchar *levels, int dx, int dy, uint *leaf, int n)
 {
     int x0 = dx < 0 ? AA_TREE_SIDE - AA_BAND : 0, x1 = dx > 0 ? AA_BAND : AA_TREE_SIDE;
     int y0 = dy < 0 ? AA_TREE_SIDE - AA_BAND : 0, y1 = dy > 0 ? AA_BAND : AA_TREE_SIDE;
     int deepest = 0;
-    return aa_region_leaves(cells, x0, x1, y0, y1, (uint)((dy + 1) * 3 + dx + 1),
+    return aa_region_leaves(levels, x0, x1, y0, y1, (uint)((dy + 1) * 3 + dx + 1),
                             2 * (AA_BAND + dx * AA_TREE_SIDE), 2 * (AA_BAND + dy * AA_TREE_SIDE),
                             leaf, n, &deepest);
 }
@@ -293,14 +349,13 @@ VB_INLINE void aa_nearest_weights(const uint *leaf, int n, int nown, float *w)
     }
 }
 
-/* Writes value (rgb) and level lv into the cells of node `code` of a tree slot. */
-VB_INLINE void aa_fill_node(__global float *cells, unsigned int code, float3 v, int lv)
+/* Writes level lv into the cells of node `code` of a tree slot's levels. */
+VB_INLINE void aa_fill_levels(__global uchar *levels, unsigned int code, int lv)
 {
     int s = AA_TREE_SIDE >> aa_node_level(code);
     int ox = aa_node_x(code) * s, oy = aa_node_y(code) * s;
     for (int y = oy; y < oy + s; y++)
-        for (int x = ox; x < ox + s; x++)
-            vstore4((float4)(v, (float)lv), y * AA_TREE_SIDE + x, cells);
+        for (int x = ox; x < ox + s; x++) levels[y * AA_TREE_SIDE + x] = (uchar)lv;
 }
 
 #endif

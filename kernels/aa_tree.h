@@ -22,6 +22,17 @@
 
 #define AA_TREE_SIDE        16  /* finest cells per pixel axis: 2^VBCL_AA_MAX_LEVEL */
 #define AA_TREE_CENTRE_CELL 136 /* (8, 8): the cell holding the pixel centre */
+#define AA_TREE_NODES       340 /* nodes at levels 1 .. 4: 4 + 16 + 64 + 256 */
+
+/* A refined pixel's tree lives in a slot of two buffers: its levels, one byte per finest
+ * cell (the level of the leaf covering it), and its values, one float4 per node at levels
+ * 1 .. 4 (the value of the node's sample). The values are kept level by level: level L
+ * (4^L nodes per slot) begins at cap * aa_level_base(L), cap the slots the buffers hold,
+ * so a pixel refined only to level 1 uses 64 bytes of them. */
+AA_TREE_FN int aa_level_base(int level)
+{
+    return ((1 << (2 * level)) - 4) / 3;
+}
 
 /* A node as one integer: level in bits 8-10, y in bits 4-7, x in bits 0-3. */
 AA_TREE_FN unsigned int aa_node_code(int level, int x, int y)
@@ -65,15 +76,35 @@ AA_TREE_FN int aa_node_sample_cell(int level, int x, int y)
     return fy * AA_TREE_SIDE + fx;
 }
 
+/* Which of the four children of node `code` (0 .. 3: x | y << 1 within the node) holds
+ * its sample. */
+AA_TREE_FN int aa_kept_index(unsigned int code)
+{
+    int level = aa_node_level(code);
+    int cell = aa_node_sample_cell(level, aa_node_x(code), aa_node_y(code));
+    int s = AA_TREE_SIDE >> (level + 1);
+    return ((cell / AA_TREE_SIDE / s) & 1) * 2 + ((cell % AA_TREE_SIDE / s) & 1);
+}
+
+/* Child c (0 .. 3: x | y << 1 within the node) of node `code`. */
+AA_TREE_FN unsigned int aa_child(unsigned int code, int c)
+{
+    return aa_node_code(aa_node_level(code) + 1, 2 * aa_node_x(code) + (c & 1),
+                        2 * aa_node_y(code) + (c >> 1));
+}
+
+/* The child of node `code` that holds its sample and keeps its value when it splits. */
+AA_TREE_FN unsigned int aa_kept_child(unsigned int code)
+{
+    return aa_child(code, aa_kept_index(code));
+}
+
 /* Child j (0, 1, 2) of the three children of node `code` that do not hold its sample: the
  * children that need new samples when the node splits. */
 AA_TREE_FN unsigned int aa_new_child(unsigned int code, int j)
 {
-    int level = aa_node_level(code), x = aa_node_x(code), y = aa_node_y(code);
-    int cell = aa_node_sample_cell(level, x, y), s = AA_TREE_SIDE >> (level + 1);
-    int keep = ((cell / AA_TREE_SIDE / s) & 1) * 2 + ((cell % AA_TREE_SIDE / s) & 1);
-    int c = j < keep ? j : j + 1;
-    return aa_node_code(level + 1, 2 * x + (c & 1), 2 * y + (c >> 1));
+    int keep = aa_kept_index(code);
+    return aa_child(code, j < keep ? j : j + 1);
 }
 
 #endif

@@ -9,10 +9,10 @@
  *   tree_trace_bands        splits             -> radiance += the recorded dispersive
  *                                                 subtrees (only with VBCL_HAS_DISPERSION)
  *   aa_reconstruct          radiance           -> film (--ssaa: box window per pixel)
- *   aa_contrast_mark        film, tree         -> marks (quadtree leaves to split)
+ *   aa_contrast_mark        film, trees        -> marks (quadtree leaves to split)
  *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
- *   aa_split_store          radiance, marks    -> tree (four leaves for each split node)
- *   aa_resolve              tree, slots        -> film, info (each pixel from its samples)
+ *   aa_split_store          radiance, marks    -> trees (four leaves for each split node)
+ *   aa_resolve              trees, slots       -> film, info (each pixel from its samples)
  * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
  * adds the pass, aa_split_rays the pass and the list, with dispersion the tree kernels add
  * the split records, the other aa_* kernels take only their own buffers), are
@@ -374,17 +374,24 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float
     vstore4(sum * (1.0f / (float)n), aa->first + j, film);
 }
 
-/* film, slots, tree, changed -> marks, counts: over the whole image, every leaf below the
- * top level against its adjacent leaves (aa_leaf_fails), in pixels whose neighbourhood
- * changed last round; a failing leaf is appended to marks as (pixel, node code). counts[0]
- * counts the marks, counts[1 + l] those at level l. */
+/* film, slots, trees, changed, split -> marks, counts: over the whole image, every leaf
+ * below the top level against its adjacent leaves (aa_leaf_fails): in round 0 all, later
+ * those in pixels whose neighbourhood changed last round (aa_pixel_dirty) that lie in or
+ * next to a block split last round (aa_leaf_touched; split holds two rounds' blocks, the
+ * last round's read and this round's cleared); a failing leaf is appended to marks as
+ * (pixel, node code). counts[0] counts the marks, counts[1 + l] those at level l. */
 __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
-                               __global const int *slots, __global const float *tree,
-                               __global uint2 *marks, __global uint *counts,
-                               __global const int *changed)
+                               __global const int *slots, __global const uchar *levels,
+                               __global const float *values, __global uint2 *marks,
+                               __global uint *counts, __global const int *changed,
+                               __global uint *split)
 {
-    int p = get_global_id(0);
-    if (p >= aa->width * aa->height) return;
+    int p = get_global_id(0), npix = aa->width * aa->height;
+    AaTree tree = {levels, values, aa->tree_cap};
+    if (p >= npix) return;
+    /* this round's splits are recorded in the other half of split[] */
+    __global const uint *last = split + (aa->round + 1) % 2 * npix;
+    split[aa->round % 2 * npix + p] = 0u;
     int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
     if (!aa_pixel_dirty(aa, changed, x, y)) return;
     if (slot < 0) {
@@ -399,16 +406,16 @@ __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const flo
         marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
         return;
     }
+    __global const uchar *own = levels + (size_t)slot * VBCL_AA_CELLS;
     for (int fy = 0; fy < AA_TREE_SIDE; fy++) /* each row one leaf at a time */
         for (int fx = 0; fx < AA_TREE_SIDE;) {
-            float4 c =
-                vload4((size_t)slot * VBCL_AA_CELLS + (size_t)(fy * AA_TREE_SIDE + fx), tree);
-            int lv = (int)c.w, s = AA_TREE_SIDE >> lv, at = fx;
+            int lv = own[fy * AA_TREE_SIDE + fx], s = AA_TREE_SIDE >> lv, at = fx;
             fx += s;
             if (lv >= aa->max_level || fy % s) continue; /* not the leaf's first row */
-            if (!aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE + at, y * AA_TREE_SIDE + fy,
-                               s, lv, aa_display(aa, c.xyz)))
-                continue;
+            int X0 = x * AA_TREE_SIDE + at, Y0 = y * AA_TREE_SIDE + fy;
+            if (aa->round > 0 && !aa_leaf_touched(aa, last, X0, Y0, s)) continue;
+            float3 c = vload4(aa_cell_value(tree.cap, slot, lv, at, fy), values).xyz;
+            if (!aa_leaf_fails(aa, film, slots, tree, X0, Y0, s, lv, aa_display(aa, c))) continue;
             uint m = atomic_inc(&counts[0]);
             atomic_inc(&counts[1 + lv]);
             marks[m] = (uint2)((uint)p, aa_node_code(lv, at / s, fy / s));
@@ -432,59 +439,67 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
                          aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
 }
 
-/* radiance, marks -> tree, slots, slot_pixels, changed: each marked node of a batch becomes
- * four leaves one level deeper: the child holding the node's sample keeps its value, the
- * other three take the new samples. A pixel split for the first time gets a tree slot
- * (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them); every
- * split pixel records the round in changed. */
+/* radiance, marks -> levels, values, slots, slot_pixels, changed, split: each marked node
+ * of a batch becomes four leaves one level deeper: the child holding the node's sample keeps
+ * its value, the other three take the new samples. A pixel split for the first time gets a
+ * tree slot (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them);
+ * every split pixel records the round in changed and the node's blocks (aa_node_blocks) in
+ * this round's half of split. */
 __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2 *marks,
                              __global const float *radiance, __global const float *film,
-                             __global int *slots, __global int *slot_pixels, __global float *tree,
-                             __global uint *counts, __global int *changed)
+                             __global int *slots, __global int *slot_pixels, __global uchar *levels,
+                             __global float *values, __global uint *counts, __global int *changed,
+                             __global uint *split)
 {
     uint j = get_global_id(0);
     if (j >= aa->entries) return;
     uint2 m = marks[aa->first + j];
     int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
     changed[m.x] = aa->round;
+    atomic_or(&split[aa->round % 2 * aa->width * aa->height + (int)m.x], aa_node_blocks(m.y));
     if (slot < 0) {
         slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
         slots[m.x] = slot;
         slot_pixels[slot] = (int)m.x;
     }
-    __global float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
-    if (lv == 1) {
-        aa_fill_node(cells, m.y, vload4(m.x, film).xyz, lv);
-    } else {
-        int s = AA_TREE_SIDE >> (lv - 1);
-        int ox = aa_node_x(m.y) * s, oy = aa_node_y(m.y) * s;
-        for (int y = oy; y < oy + s; y++)
-            for (int x = ox; x < ox + s; x++) cells[4 * (y * AA_TREE_SIDE + x) + 3] = (float)lv;
+    uint cap = aa->tree_cap, kept = aa_kept_child(m.y);
+    float4 v =
+        lv == 1 ? vload4(m.x, film)
+                : vload4(aa_node_value(cap, slot, lv - 1, aa_node_x(m.y), aa_node_y(m.y)), values);
+    aa_fill_levels(levels + (size_t)slot * VBCL_AA_CELLS, m.y, lv);
+    vstore4((float4)(v.xyz, 0.0f), aa_node_value(cap, slot, lv, aa_node_x(kept), aa_node_y(kept)),
+            values);
+    for (int k = 0; k < 3; k++) {
+        uint c = aa_new_child(m.y, k);
+        vstore4((float4)(vload4(3 * j + (uint)k, radiance).xyz, 0.0f),
+                aa_node_value(cap, slot, lv, aa_node_x(c), aa_node_y(c)), values);
     }
-    for (int k = 0; k < 3; k++)
-        aa_fill_node(cells, aa_new_child(m.y, k), vload4(3 * j + (uint)k, radiance).xyz, lv);
 }
 
-/* tree, slot_pixels, slots -> film, info: each refined pixel becomes the mean of its finest
- * cells (a box window over the pixel's own footprint, figure 4.4), each cell the value of
- * the sample nearest to it among the pixel's own and its refined neighbours' near it
- * (aa_nearest_weights; from[s] is the tree slot of the pixel at source s) or, with
+/* levels, values, slot_pixels, slots -> film, info: each refined pixel becomes the mean of
+ * its finest cells (a box window over the pixel's own footprint, figure 4.4), each cell the
+ * value of the sample nearest to it among the pixel's own and its refined neighbours' near
+ * it (aa_nearest_weights; from[s] is the tree slot of the pixel at source s) or, with
  * aa->reconstruct 1, of the leaf covering it (the area-weighted mean of the leaves, the
  * thesis's); info its deepest level | leaf count << 8. */
 __kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot_pixels,
-                         __global const float *tree, __global float *film, __global int *info,
-                         __global const int *slots)
+                         __global const uchar *levels, __global const float *values,
+                         __global float *film, __global int *info, __global const int *slots)
 {
     uint slot = get_global_id(0);
     if (slot >= aa->entries) return;
-    __global const float *cells = tree + (size_t)slot * VBCL_AA_CELLS * 4;
+    __global const uchar *own = levels + (size_t)slot * VBCL_AA_CELLS;
     uint leaf[AA_EXT_MAX];
     float w[AA_EXT_MAX];
+    uint cap = aa->tree_cap;
     int p = slot_pixels[slot];
-    int deepest = 0, nown = aa_leaf_list(cells, leaf, &deepest);
+    int deepest = 0, nown = aa_leaf_list(own, leaf, &deepest);
     float3 sum = (float3)(0.0f);
-    if (aa->reconstruct == 1) { /* each cell holds the value of the leaf covering it */
-        for (int k = 0; k < VBCL_AA_CELLS; k++) sum += vload4(k, cells).xyz;
+    if (aa->reconstruct == 1) { /* each cell the value of the leaf covering it */
+        for (int k = 0; k < VBCL_AA_CELLS; k++)
+            sum += vload4(aa_cell_value(cap, (int)slot, own[k], k % AA_TREE_SIDE, k / AA_TREE_SIDE),
+                          values)
+                       .xyz;
     } else {
         int x = p % aa->width, y = p / aa->width, n = nown, from[9];
         for (int dy = -1; dy <= 1; dy++)
@@ -495,15 +510,17 @@ __kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot
                     y + dy >= aa->height || slots[q] < 0)
                     continue;
                 from[src] = slots[q];
-                n = aa_band_list(tree + (size_t)slots[q] * VBCL_AA_CELLS * 4, dx, dy, leaf, n);
+                n = aa_band_list(levels + (size_t)slots[q] * VBCL_AA_CELLS, dx, dy, leaf, n);
             }
         aa_nearest_weights(leaf, n, nown, w);
         for (int i = 0; i < n; i++)
-            if (w[i] > 0.0f)
-                sum += w[i] *
-                       vload4((size_t)from[leaf[i] >> 28] * VBCL_AA_CELLS + (leaf[i] >> 16 & 255u),
-                              tree)
-                           .xyz;
+            if (w[i] > 0.0f) {
+                int at = (int)(leaf[i] >> 16 & 255u), lv = (int)(leaf[i] >> 24 & 15u);
+                sum += w[i] * vload4(aa_cell_value(cap, from[leaf[i] >> 28], lv, at % AA_TREE_SIDE,
+                                                   at / AA_TREE_SIDE),
+                                     values)
+                                  .xyz;
+            }
     }
     vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
     info[p] = deepest | nown << 8;

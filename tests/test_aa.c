@@ -418,6 +418,25 @@ static void test_aa_samples_nested_never_retraced(void)
     }
 }
 
+/* The kernels' storage of n trees (aa_tree.h) from trees written here as 256 finest cells
+ * of 4 floats (the rgb of the leaf covering the cell, its level 1 .. 4): each cell's level
+ * (levels: n x 256 bytes) and each leaf's value at its node (values: n x AA_TREE_NODES
+ * float4, level by level, a capacity of n slots). */
+static void trees_pack(const float *cells, int n, unsigned char *levels, float *values)
+{
+    for (int t = 0; t < n; t++)
+        for (int k = 0; k < VBCL_AA_CELLS; k++) {
+            const float *c = cells + ((size_t)t * VBCL_AA_CELLS + (size_t)k) * 4;
+            int lv = (int)c[3], shift = VBCL_AA_MAX_LEVEL - lv;
+            int x = k % AA_TREE_SIDE >> shift, y = k / AA_TREE_SIDE >> shift;
+            size_t node = (size_t)n * (size_t)aa_level_base(lv) + ((size_t)t << (2 * lv)) +
+                          (size_t)((y << lv) + x);
+            levels[(size_t)t * VBCL_AA_CELLS + (size_t)k] = (unsigned char)lv;
+            for (int i = 0; i < 3; i++) values[4 * node + (size_t)i] = c[i];
+            values[4 * node + 3] = 0.0f;
+        }
+}
+
 /* One two-pixel case of the contrast kernel: pixel 0 is a tree with every leaf at level
  * l0 and value v0, pixel 1 at level l1 and value v1, except pixel 1's leaves listed in
  * odd (codes) with value v_odd; want lists the marks expected as pixel << 16 | code. */
@@ -444,14 +463,17 @@ static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, u
     }
 }
 
-static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const int changed[2])
+static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const int changed[2],
+                          unsigned blocks)
 {
-    static float tree[2 * VBCL_AA_CELLS * 4];
+    static float tree[2 * VBCL_AA_CELLS * 4], values[2 * AA_TREE_NODES * 4];
+    static unsigned char levels[2 * VBCL_AA_CELLS];
     float film[8] = {0};
     int slots[2] = {0, 1};
     cl_uint counts[VBCL_AA_MAX_LEVEL + 2] = {0}, marks[2 * 64] = {0};
     two_pixel_fill(tree, tc->l0, tc->v0, NULL, 0, 0.0f);
     two_pixel_fill(tree + VBCL_AA_CELLS * 4, tc->l1, tc->v1, tc->odd, tc->nodd, tc->v_odd);
+    trees_pack(tree, 2, levels, values);
     VbAaPass pass;
     memset(&pass, 0, sizeof pass);
     pass.threshold = 0.1f;
@@ -462,16 +484,23 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
     pass.width = 2;
     pass.height = 1;
     pass.round = round;
-    cl_mem m[7] = {buffer(&pass, sizeof pass),      buffer(film, sizeof film),
-                   buffer(slots, sizeof slots),     buffer(tree, sizeof tree),
-                   buffer(marks, sizeof marks),     buffer(counts, sizeof counts),
-                   buffer(changed, 2 * sizeof(int))};
-    const size_t sz[7] = {sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem),
-                          sizeof(cl_mem), sizeof(cl_mem), sizeof(cl_mem)};
-    const void *v[7] = {&m[0], &m[1], &m[2], &m[3], &m[4], &m[5], &m[6]};
-    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 7, sz, v) == 0) {
-        read_buffer(m[4], marks, sizeof marks);
-        read_buffer(m[5], counts, sizeof counts);
+    pass.tree_cap = 2;
+    cl_uint split[4] = {0}; /* two rounds' halves: pixel 1's blocks split last round */
+    split[(round + 1) % 2 * 2 + 1] = blocks;
+    cl_mem m[9] = {buffer(&pass, sizeof pass),    buffer(film, sizeof film),
+                   buffer(slots, sizeof slots),   buffer(levels, sizeof levels),
+                   buffer(values, sizeof values), buffer(marks, sizeof marks),
+                   buffer(counts, sizeof counts), buffer(changed, 2 * sizeof(int)),
+                   buffer(split, sizeof split)};
+    size_t sz[9];
+    const void *v[9];
+    for (int i = 0; i < 9; i++) {
+        sz[i] = sizeof(cl_mem);
+        v[i] = &m[i];
+    }
+    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 9, sz, v) == 0) {
+        read_buffer(m[5], marks, sizeof marks);
+        read_buffer(m[6], counts, sizeof counts);
         int missing = 0;
         for (unsigned w = 0; w < tc->nwant; w++) {
             int found = 0;
@@ -483,7 +512,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
               "%s, round %d: %u marks, %u expected, %d missing", tc->what, round, counts[0],
               tc->nwant, missing);
     }
-    for (int i = 0; i < 7; i++) clReleaseMemObject(m[i]);
+    for (int i = 0; i < 9; i++) clReleaseMemObject(m[i]);
 }
 
 #define P0(l, x, y) (0u << 16 | ((l) << 8 | (y) << 4 | (x)))
@@ -493,9 +522,10 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
  * contrast kernel itself with two refined pixels side by side: a leaf is compared with
  * each adjacent leaf of its neighbour at the finer level of the two (8-neighbourhood, so
  * corners count), and of a failing pair the leaf at the lower level splits, both on a tie.
- * After round 0 only pixels whose neighbourhood was split in the last round are tested:
- * the same cases in round 1 mark the same leaves when pixel 1 was split in round 0, and
- * nothing when the last split was earlier. */
+ * After round 0 only leaves in or next to a block of cells split in the last round are
+ * tested: the same cases in round 1 mark the same leaves when all of pixel 1 was split in
+ * round 0, nothing when the last split was earlier, and nothing when round 0 split only
+ * pixel 1's bottom-right block, which no leaf the cases mark lies in or next to. */
 static void test_aa_neighbour_rule_across_levels(void)
 {
     Fixture fx;
@@ -612,11 +642,14 @@ static void test_aa_neighbour_rule_across_levels(void)
     };
     const int fresh[2] = {-1, 0}, stale[2] = {-1, -1};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        two_pixel_run(&fx, &cases[i], 0, stale);
-        two_pixel_run(&fx, &cases[i], 1, fresh);
+        two_pixel_run(&fx, &cases[i], 0, stale, 0u);
+        two_pixel_run(&fx, &cases[i], 1, fresh, 0xffffu);
         TwoPixelCase none = cases[i];
         none.nwant = 0;
-        two_pixel_run(&fx, &none, 2, fresh);
+        two_pixel_run(&fx, &none, 2, fresh, 0xffffu);
+        /* split last round only in pixel 1's bottom-right 4 x 4 cells: no leaf of the
+         * cases' marks (all within 8 cells of the border) lies in or next to them */
+        two_pixel_run(&fx, &none, 1, fresh, 0x8000u);
     }
     fixture_close(&fx);
 }
@@ -696,7 +729,8 @@ static void test_aa_resolve_nearest_samples(void)
                           "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
         return;
     enum { TREES = RES_TREES, NPIX = RES_W * RES_H };
-    static float tree[TREES * VBCL_AA_CELLS * 4];
+    static float tree[TREES * VBCL_AA_CELLS * 4], values[TREES * AA_TREE_NODES * 4];
+    static unsigned char levels[TREES * VBCL_AA_CELLS];
     static unsigned leaves[TREES][VBCL_AA_CELLS];
     static float value[TREES][VBCL_AA_CELLS];
     int nleaves[TREES], deepest[TREES], pixels[TREES], tree_at[NPIX], slots[NPIX];
@@ -745,6 +779,7 @@ static void test_aa_resolve_nearest_samples(void)
                 }
         }
     }
+    trees_pack(tree, TREES, levels, values);
     for (int mode = 0; mode < 2; mode++) {
         float film[NPIX * 4];
         int info[NPIX];
@@ -754,20 +789,22 @@ static void test_aa_resolve_nearest_samples(void)
         pass.reconstruct = mode;
         pass.width = RES_W;
         pass.height = RES_H;
+        pass.tree_cap = TREES;
         memset(film, 0, sizeof film);
         memset(info, 0, sizeof info);
-        cl_mem m[6] = {buffer(&pass, sizeof pass), buffer(pixels, sizeof pixels),
-                       buffer(tree, sizeof tree),  buffer(film, sizeof film),
-                       buffer(info, sizeof info),  buffer(slots, sizeof slots)};
-        size_t sz[6];
-        const void *v[6];
-        for (int i = 0; i < 6; i++) {
+        cl_mem m[7] = {buffer(&pass, sizeof pass),    buffer(pixels, sizeof pixels),
+                       buffer(levels, sizeof levels), buffer(values, sizeof values),
+                       buffer(film, sizeof film),     buffer(info, sizeof info),
+                       buffer(slots, sizeof slots)};
+        size_t sz[7];
+        const void *v[7];
+        for (int i = 0; i < 7; i++) {
             sz[i] = sizeof(cl_mem);
             v[i] = &m[i];
         }
-        if (run_kernel(fx.r.program, "aa_resolve", TREES, 6, sz, v) == 0) {
-            read_buffer(m[3], film, sizeof film);
-            read_buffer(m[4], info, sizeof info);
+        if (run_kernel(fx.r.program, "aa_resolve", TREES, 7, sz, v) == 0) {
+            read_buffer(m[4], film, sizeof film);
+            read_buffer(m[5], info, sizeof info);
             int bad = 0, bad_info = 0, differs = 0;
             double worst = 0.0;
             for (int t = 0; t < TREES; t++) {
@@ -820,7 +857,7 @@ static void test_aa_resolve_nearest_samples(void)
                       mode, t, 256.0 * (1.0 - film[4 * pixels[t]]), centre);
             }
         }
-        for (int i = 0; i < 6; i++) clReleaseMemObject(m[i]);
+        for (int i = 0; i < 7; i++) clReleaseMemObject(m[i]);
     }
     fixture_close(&fx);
 }

@@ -8,6 +8,8 @@
  * every pixel. */
 #include "aa.h"
 
+#include "aa_tree.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +38,9 @@ static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t 
     aa->info = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->counts = clu_buffer(d, NULL, sizeof(cl_uint) * AA_COUNTS, CL_MEM_READ_WRITE);
     aa->changed = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
-    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->changed) return 0;
+    aa->split = clu_buffer(d, NULL, sizeof(cl_uint) * 2 * npix, CL_MEM_READ_WRITE);
+    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->changed && aa->split)
+        return 0;
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
 }
@@ -74,6 +78,52 @@ fail:
     return 1;
 }
 
+/* Makes the trees hold at least `need` slots, keeping the first `keep`: both buffers grow
+ * to twice the need together (the values' levels begin at multiples of the capacity,
+ * aa_tree.h), each level of the values copied to its new place. Returns as aa_reserve. */
+static int aa_reserve_trees(AaState *aa, Renderer *r, size_t need, size_t keep, char *err,
+                            size_t errlen)
+{
+    VbDevice *d = r->dev;
+    if (need <= aa->tree_cap) return 0;
+    size_t elem = sizeof(float) * 4 * AA_TREE_NODES, want = 2 * need;
+    if (want * elem > d->max_alloc) want = d->max_alloc / elem;
+    if (want < need) {
+        snprintf(err, errlen,
+                 "anti-aliasing needs %.0f MiB for its trees, more than one allocation on %s "
+                 "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
+                 (double)(need * elem) / 1048576.0, d->name, (double)d->max_alloc / 1048576.0);
+        return 2;
+    }
+    cl_mem levels = clu_buffer(d, NULL, want * VBCL_AA_CELLS, CL_MEM_READ_WRITE);
+    cl_mem values = levels ? clu_buffer(d, NULL, want * elem, CL_MEM_READ_WRITE) : NULL;
+    if (!values) goto fail;
+    if (keep) {
+        CL_CHECK(clEnqueueCopyBuffer(d->queue, aa->levels, levels, 0, 0, keep * VBCL_AA_CELLS, 0,
+                                     NULL, NULL),
+                 fail);
+        for (int l = 1; l <= VBCL_AA_MAX_LEVEL; l++) {
+            size_t node = sizeof(float) * 4, per = (size_t)1 << (2 * l);
+            size_t base = (size_t)aa_level_base(l);
+            CL_CHECK(clEnqueueCopyBuffer(d->queue, aa->values, values, base * aa->tree_cap * node,
+                                         base * want * node, keep * per * node, 0, NULL, NULL),
+                     fail);
+        }
+    }
+    CL_CHECK(clFinish(d->queue), fail);
+    if (aa->levels) CL_WARN(clReleaseMemObject(aa->levels));
+    if (aa->values) CL_WARN(clReleaseMemObject(aa->values));
+    aa->levels = levels;
+    aa->values = values;
+    aa->tree_cap = want;
+    return 0;
+fail:
+    if (levels) CL_WARN(clReleaseMemObject(levels));
+    if (values) CL_WARN(clReleaseMemObject(values));
+    snprintf(err, errlen, "%s: %s", d->name, clu_error());
+    return 1;
+}
+
 /* Enqueues kernel k over `global` work items with the given buffers as its arguments
  * (from argument `first` on) and waits; adds its device time to *ms. Returns 0 or -1. */
 static int aa_launch(Renderer *r, cl_kernel k, cl_uint first, const cl_mem *args, int nargs,
@@ -95,8 +145,9 @@ fail:
     return -1;
 }
 
-static int aa_write_pass(AaState *aa, Renderer *r, const VbAaPass *pass)
+static int aa_write_pass(AaState *aa, Renderer *r, VbAaPass *pass)
 {
+    pass->tree_cap = (unsigned)aa->tree_cap;
     CL_CHECK(clEnqueueWriteBuffer(r->dev->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL,
                                   NULL),
              fail);
@@ -107,8 +158,8 @@ fail:
 
 /* Traces `nrays` rays that kernel gen (a frame kernel taking the pass, and the mark list
  * when marks is set) generates for the batch in pass, into r->radiance. Returns 0 or -1. */
-static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, const VbAaPass *pass,
-                          int with_marks, int nrays, RenderStats *st)
+static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, VbAaPass *pass, int with_marks,
+                          int nrays, RenderStats *st)
 {
     const cl_uint a = RENDER_FRAME_ARGS;
     double gen_ms = 0.0, trace_ms = 0.0;
@@ -127,7 +178,7 @@ static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, const VbAaPas
 /* The contrast pass: marks the leaves to split into aa->marks; counts[0] receives how many,
  * counts[1 + l] how many at level l, counts[AA_COUNTS - 1] the tree slots in use. Returns
  * 0 or -1. */
-static int aa_mark(AaState *aa, Renderer *r, const Scene *s, const VbAaPass *pass,
+static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass,
                    cl_uint counts[AA_COUNTS], RenderStats *st)
 {
     VbDevice *d = r->dev;
@@ -136,9 +187,9 @@ static int aa_mark(AaState *aa, Renderer *r, const Scene *s, const VbAaPass *pas
     CL_CHECK(
         clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL, NULL),
         fail);
-    const cl_mem args[7] = {aa->pass,  aa->film,   aa->slots,  aa->tree,
-                            aa->marks, aa->counts, aa->changed};
-    if (aa_launch(r, r->k_aa_contrast, 0, args, 7, (size_t)s->width * (size_t)s->height,
+    const cl_mem args[9] = {aa->pass,  aa->film,   aa->slots,   aa->levels, aa->values,
+                            aa->marks, aa->counts, aa->changed, aa->split};
+    if (aa_launch(r, r->k_aa_contrast, 0, args, 9, (size_t)s->width * (size_t)s->height,
                   &st->aa_contrast_ms))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
@@ -181,13 +232,10 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
         pass->first = done;
         pass->entries = k;
         if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
-        const cl_mem args[7] = {aa->pass,  aa->marks,       r->radiance, aa->film,
-                                aa->slots, aa->slot_pixels, aa->tree};
-        const cl_mem more[2] = {aa->counts, aa->changed};
-        if (clu_set_arg(r->k_aa_split_store, 7, sizeof(cl_mem), &more[0]) ||
-            clu_set_arg(r->k_aa_split_store, 8, sizeof(cl_mem), &more[1]) ||
-            aa_launch(r, r->k_aa_split_store, 0, args, 7, k, &st->aa_reconstruct_ms))
-            return -1;
+        const cl_mem args[11] = {aa->pass,   aa->marks,       r->radiance, aa->film,
+                                 aa->slots,  aa->slot_pixels, aa->levels,  aa->values,
+                                 aa->counts, aa->changed,     aa->split};
+        if (aa_launch(r, r->k_aa_split_store, 0, args, 11, k, &st->aa_reconstruct_ms)) return -1;
         st->samples += 3ull * k;
         aa_progress(pg, round, level, st->samples, npix, done + k, marked);
     }
@@ -203,9 +251,10 @@ static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, u
     VbDevice *d = r->dev;
     size_t npix = (size_t)s->width * (size_t)s->height;
     pass->entries = slots;
-    const cl_mem args[6] = {aa->pass, aa->slot_pixels, aa->tree, aa->film, aa->info, aa->slots};
+    const cl_mem args[7] = {aa->pass, aa->slot_pixels, aa->levels, aa->values,
+                            aa->film, aa->info,        aa->slots};
     if (slots && (aa_write_pass(aa, r, pass) ||
-                  aa_launch(r, r->k_aa_resolve, 0, args, 6, slots, &st->aa_reconstruct_ms)))
+                  aa_launch(r, r->k_aa_resolve, 0, args, 7, slots, &st->aa_reconstruct_ms)))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
@@ -242,8 +291,7 @@ static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba,
         snprintf(err, errlen, "out of memory");
         return 1;
     }
-    int rc = aa_reserve(r, &aa->tree, &aa->tree_cap, 64, sizeof(float) * 4 * VBCL_AA_CELLS, 0,
-                        "trees", err, errlen);
+    int rc = aa_reserve_trees(aa, r, 64, 0, err, errlen);
     if (!rc)
         rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, 64, sizeof(cl_int), 0, "trees",
                         err, errlen);
@@ -322,8 +370,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         st->aa_rounds++;
         /* pixels split for the first time take a tree slot each */
         size_t need = (size_t)slots + counts[1];
-        rc = aa_reserve(r, &aa->tree, &aa->tree_cap, need, sizeof(float) * 4 * VBCL_AA_CELLS, slots,
-                        "trees", err, errlen);
+        rc = aa_reserve_trees(aa, r, need, slots, err, errlen);
         if (!rc)
             rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, need, sizeof(cl_int), slots,
                             "trees", err, errlen);
@@ -385,8 +432,9 @@ fail:
 
 void aa_release(AaState *aa)
 {
-    cl_mem *mems[] = {&aa->pass, &aa->film,        &aa->slots, &aa->info,   &aa->counts,
-                      &aa->tree, &aa->slot_pixels, &aa->marks, &aa->changed};
+    cl_mem *mems[] = {&aa->pass,   &aa->film,    &aa->slots,  &aa->info,
+                      &aa->counts, &aa->levels,  &aa->values, &aa->slot_pixels,
+                      &aa->marks,  &aa->changed, &aa->split};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);

@@ -12,13 +12,15 @@
 #define AA_MAX_ROUNDS 256
 
 /* Anti-aliasing's own device state, created on first use: the film (the image being
- * refined), each pixel's tree slot, the pool of trees (256 cells of 16 bytes per refined
- * pixel, grown as pixels are refined), the list of marked nodes and the counters. */
+ * refined), each pixel's tree slot, the trees (per refined pixel 256 bytes of levels and
+ * 340 node values of 16 bytes, aa_tree.h; grown as pixels are refined), the list of marked
+ * nodes and the counters. */
 typedef struct AaState {
     cl_mem pass, film, slots, info, counts;
-    cl_mem changed;           /* each pixel's last round of splits, or -1 */
-    cl_mem tree, slot_pixels; /* tree_cap slots */
-    cl_mem marks;             /* mark_cap entries of (pixel, node code) */
+    cl_mem changed; /* each pixel's last round of splits, or -1 */
+    cl_mem split;   /* two rounds' split blocks of each pixel (aa_contrast_mark) */
+    cl_mem levels, values, slot_pixels; /* tree_cap slots (slot_pixels slot_pixels_cap) */
+    cl_mem marks;                       /* mark_cap entries of (pixel, node code) */
     size_t tree_cap, slot_pixels_cap, mark_cap;
     int *levels_host; /* after an adaptive render: each pixel's deepest level, else NULL */
     int *leaves_host; /* after an adaptive render: each pixel's number of leaves, else NULL */
