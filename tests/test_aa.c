@@ -418,6 +418,18 @@ static void test_aa_samples_nested_never_retraced(void)
     }
 }
 
+/* Runs kernel `name` of prog over n work items with the nargs buffers m as its arguments. */
+static int run_buffers(cl_program prog, const char *name, size_t n, const cl_mem *m, int nargs)
+{
+    size_t sz[16];
+    const void *v[16];
+    for (int i = 0; i < nargs && i < 16; i++) {
+        sz[i] = sizeof(cl_mem);
+        v[i] = &m[i];
+    }
+    return nargs <= 16 ? run_kernel(prog, name, n, nargs, sz, v) : -1;
+}
+
 /* The kernels' storage of n trees (aa_tree.h) from trees written here as 256 finest cells
  * of 4 floats (the rgb of the leaf covering the cell, its level 1 .. 4): each cell's level
  * (levels: n x 256 bytes) and each leaf's value at its node (values: n x AA_TREE_NODES
@@ -492,13 +504,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, const 
                    buffer(values, sizeof values), buffer(marks, sizeof marks),
                    buffer(counts, sizeof counts), buffer(changed, 2 * sizeof(int)),
                    buffer(split, sizeof split)};
-    size_t sz[9];
-    const void *v[9];
-    for (int i = 0; i < 9; i++) {
-        sz[i] = sizeof(cl_mem);
-        v[i] = &m[i];
-    }
-    if (run_kernel(fx->r.program, "aa_contrast_mark", 2, 9, sz, v) == 0) {
+    if (run_buffers(fx->r.program, "aa_contrast_mark", 2, m, 9) == 0) {
         read_buffer(m[5], marks, sizeof marks);
         read_buffer(m[6], counts, sizeof counts);
         int missing = 0;
@@ -796,13 +802,7 @@ static void test_aa_resolve_nearest_samples(void)
                        buffer(levels, sizeof levels), buffer(values, sizeof values),
                        buffer(film, sizeof film),     buffer(info, sizeof info),
                        buffer(slots, sizeof slots)};
-        size_t sz[7];
-        const void *v[7];
-        for (int i = 0; i < 7; i++) {
-            sz[i] = sizeof(cl_mem);
-            v[i] = &m[i];
-        }
-        if (run_kernel(fx.r.program, "aa_resolve", TREES, 7, sz, v) == 0) {
+        if (run_buffers(fx.r.program, "aa_resolve", TREES, m, 7) == 0) {
             read_buffer(m[4], film, sizeof film);
             read_buffer(m[5], info, sizeof info);
             int bad = 0, bad_info = 0, differs = 0;
