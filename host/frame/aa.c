@@ -45,24 +45,32 @@ static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t 
     return 1;
 }
 
+/* The capacity a growing buffer of `elem`-byte elements gets when it must hold `need`:
+ * twice the need, as far as one allocation on d allows. Returns 0, or 2 (not even the need
+ * fits) with a message in err. */
+static int aa_capacity(const VbDevice *d, size_t need, size_t elem, const char *what, size_t *want,
+                       char *err, size_t errlen)
+{
+    *want = 2 * need;
+    if (*want * elem > d->max_alloc) *want = d->max_alloc / elem;
+    if (*want >= need) return 0;
+    snprintf(err, errlen,
+             "anti-aliasing needs %.0f MiB for its %s, more than one allocation on %s "
+             "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
+             (double)(need * elem) / 1048576.0, what, d->name, (double)d->max_alloc / 1048576.0);
+    return 2;
+}
+
 /* Makes *buf hold at least `need` elements of `elem` bytes (capacity *cap), keeping its
- * first `keep` elements: a new buffer of twice the need, the old contents copied. Returns
- * 0, 1 (device) or 2 (more than one allocation allows) with a message in err. */
+ * first `keep` elements: a new buffer (aa_capacity), the old contents copied. Returns 0, 1
+ * (device) or 2 (more than one allocation allows) with a message in err. */
 static int aa_reserve(Renderer *r, cl_mem *buf, size_t *cap, size_t need, size_t elem, size_t keep,
                       const char *what, char *err, size_t errlen)
 {
     VbDevice *d = r->dev;
+    size_t want;
     if (need <= *cap) return 0;
-    size_t want = 2 * need;
-    if (want * elem > d->max_alloc) want = d->max_alloc / elem;
-    if (want < need) {
-        snprintf(err, errlen,
-                 "anti-aliasing needs %.0f MiB for its %s, more than one allocation on %s "
-                 "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
-                 (double)(need * elem) / 1048576.0, what, d->name,
-                 (double)d->max_alloc / 1048576.0);
-        return 2;
-    }
+    if (aa_capacity(d, need, elem, what, &want, err, errlen)) return 2;
     cl_mem nb = clu_buffer(d, NULL, want * elem, CL_MEM_READ_WRITE);
     if (!nb) goto fail;
     if (keep)
@@ -85,16 +93,9 @@ static int aa_reserve_trees(AaState *aa, Renderer *r, size_t need, size_t keep, 
                             size_t errlen)
 {
     VbDevice *d = r->dev;
+    size_t elem = sizeof(float) * 4 * AA_TREE_NODES, want;
     if (need <= aa->tree_cap) return 0;
-    size_t elem = sizeof(float) * 4 * AA_TREE_NODES, want = 2 * need;
-    if (want * elem > d->max_alloc) want = d->max_alloc / elem;
-    if (want < need) {
-        snprintf(err, errlen,
-                 "anti-aliasing needs %.0f MiB for its trees, more than one allocation on %s "
-                 "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
-                 (double)(need * elem) / 1048576.0, d->name, (double)d->max_alloc / 1048576.0);
-        return 2;
-    }
+    if (aa_capacity(d, need, elem, "trees", &want, err, errlen)) return 2;
     cl_mem levels = clu_buffer(d, NULL, want * VBCL_AA_CELLS, CL_MEM_READ_WRITE);
     cl_mem values = levels ? clu_buffer(d, NULL, want * elem, CL_MEM_READ_WRITE) : NULL;
     if (!values) goto fail;
