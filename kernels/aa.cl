@@ -94,17 +94,16 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
 }
 
 /* Whether pixel p (x, y) needs its contrast test this round: in round 0 every pixel, later
- * only a pixel that was split last round or has a neighbour that was (changed[] holds the
- * round of each pixel's last split, or -1). A leaf's test reads only its own pixel and
- * its 8 neighbours, so a pixel none of them changed gives last round's answer again:
- * nothing (its marked leaves were split, which changed it). */
-VB_INLINE int aa_pixel_dirty(__constant const VbAaPass *aa, __global const int *changed, int x,
-                             int y)
+ * only a pixel that was split last round or has a neighbour that was (last[q]: the blocks
+ * of pixel q split last round, aa_node_blocks, 0 where none). A leaf's test reads only its
+ * own pixel and its 8 neighbours, so a pixel none of them changed gives last round's
+ * answer again: nothing (its marked leaves were split, which changed it). */
+VB_INLINE int aa_pixel_dirty(__constant const VbAaPass *aa, __global const uint *last, int x, int y)
 {
     if (aa->round == 0) return 1;
     for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
         for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++)
-            if (changed[qy * aa->width + qx] == aa->round - 1) return 1;
+            if (last[qy * aa->width + qx] != 0u) return 1;
     return 0;
 }
 

@@ -374,17 +374,16 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float
     vstore4(sum * (1.0f / (float)n), aa->first + j, film);
 }
 
-/* film, slots, trees, changed, split -> marks, counts: over the whole image, every leaf
- * below the top level against its adjacent leaves (aa_leaf_fails): in round 0 all, later
- * those in pixels whose neighbourhood changed last round (aa_pixel_dirty) that lie in or
+/* film, slots, trees, split -> marks, counts: over the whole image, every leaf below the
+ * top level against its adjacent leaves (aa_leaf_fails): in round 0 all, later those in
+ * pixels whose neighbourhood was split last round (aa_pixel_dirty) that lie in or
  * next to a block split last round (aa_leaf_touched; split holds two rounds' blocks, the
  * last round's read and this round's cleared); a failing leaf is appended to marks as
  * (pixel, node code). counts[0] counts the marks, counts[1 + l] those at level l. */
 __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
                                __global const int *slots, __global const uchar *levels,
                                __global const float *values, __global uint2 *marks,
-                               __global uint *counts, __global const int *changed,
-                               __global uint *split)
+                               __global uint *counts, __global uint *split)
 {
     int p = get_global_id(0), npix = aa->width * aa->height;
     AaTree tree = {levels, values, aa->tree_cap};
@@ -393,7 +392,7 @@ __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const flo
     __global const uint *last = split + (aa->round + 1) % 2 * npix;
     split[aa->round % 2 * npix + p] = 0u;
     int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
-    if (!aa_pixel_dirty(aa, changed, x, y)) return;
+    if (!aa_pixel_dirty(aa, last, x, y)) return;
     if (slot < 0) {
         float3 a = aa_display(aa, vload4(p, film).xyz);
         int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
@@ -439,40 +438,39 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
                          aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
 }
 
-/* radiance, marks -> levels, values, slots, slot_pixels, changed, split: each marked node
- * of a batch becomes four leaves one level deeper: the child holding the node's sample keeps
- * its value, the other three take the new samples. A pixel split for the first time gets a
- * tree slot (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them);
- * every split pixel records the round in changed and the node's blocks (aa_node_blocks) in
- * this round's half of split. */
+/* radiance, marks -> levels, values, slots, slot_pixels, split: each marked node of a
+ * batch becomes four leaves one level deeper: the child holding the node's sample keeps its
+ * value, the other three take the new samples. A pixel split for the first time gets a tree
+ * slot (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them); each
+ * split node's blocks (aa_node_blocks) are ORed into its pixel's mask in this round's half
+ * of split. */
 __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2 *marks,
                              __global const float *radiance, __global const float *film,
                              __global int *slots, __global int *slot_pixels, __global uchar *levels,
-                             __global float *values, __global uint *counts, __global int *changed,
-                             __global uint *split)
+                             __global float *values, __global uint *counts, __global uint *split)
 {
     uint j = get_global_id(0);
     if (j >= aa->entries) return;
     uint2 m = marks[aa->first + j];
     int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
-    changed[m.x] = aa->round;
     atomic_or(&split[aa->round % 2 * aa->width * aa->height + (int)m.x], aa_node_blocks(m.y));
     if (slot < 0) {
         slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
         slots[m.x] = slot;
         slot_pixels[slot] = (int)m.x;
     }
-    uint cap = aa->tree_cap, kept = aa_kept_child(m.y);
+    uint cap = aa->tree_cap;
+    int keep = aa_kept_index(m.y);
     float4 v =
         lv == 1 ? vload4(m.x, film)
                 : vload4(aa_node_value(cap, slot, lv - 1, aa_node_x(m.y), aa_node_y(m.y)), values);
     aa_fill_levels(levels + (size_t)slot * VBCL_AA_CELLS, m.y, lv);
-    vstore4((float4)(v.xyz, 0.0f), aa_node_value(cap, slot, lv, aa_node_x(kept), aa_node_y(kept)),
-            values);
-    for (int k = 0; k < 3; k++) {
-        uint c = aa_new_child(m.y, k);
-        vstore4((float4)(vload4(3 * j + (uint)k, radiance).xyz, 0.0f),
-                aa_node_value(cap, slot, lv, aa_node_x(c), aa_node_y(c)), values);
+    for (int c = 0; c < 4; c++) { /* the kept child the node's value, the others (in
+                                   * aa_new_child's order) the new samples */
+        uint child = aa_child(m.y, c);
+        float4 cv = c == keep ? v : vload4(3 * j + (uint)(c < keep ? c : c - 1), radiance);
+        vstore4((float4)(cv.xyz, 0.0f),
+                aa_node_value(cap, slot, lv, aa_node_x(child), aa_node_y(child)), values);
     }
 }
 

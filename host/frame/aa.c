@@ -37,10 +37,8 @@ static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t 
     aa->slots = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->info = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->counts = clu_buffer(d, NULL, sizeof(cl_uint) * AA_COUNTS, CL_MEM_READ_WRITE);
-    aa->changed = clu_buffer(d, NULL, sizeof(cl_int) * npix, CL_MEM_READ_WRITE);
     aa->split = clu_buffer(d, NULL, sizeof(cl_uint) * 2 * npix, CL_MEM_READ_WRITE);
-    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->changed && aa->split)
-        return 0;
+    if (aa->pass && aa->film && aa->slots && aa->info && aa->counts && aa->split) return 0;
     snprintf(err, errlen, "%s: %s", d->name, clu_error());
     return 1;
 }
@@ -188,9 +186,9 @@ static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass,
     CL_CHECK(
         clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL, NULL),
         fail);
-    const cl_mem args[9] = {aa->pass,  aa->film,   aa->slots,   aa->levels, aa->values,
-                            aa->marks, aa->counts, aa->changed, aa->split};
-    if (aa_launch(r, r->k_aa_contrast, 0, args, 9, (size_t)s->width * (size_t)s->height,
+    const cl_mem args[8] = {aa->pass,   aa->film,  aa->slots,  aa->levels,
+                            aa->values, aa->marks, aa->counts, aa->split};
+    if (aa_launch(r, r->k_aa_contrast, 0, args, 8, (size_t)s->width * (size_t)s->height,
                   &st->aa_contrast_ms))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
@@ -233,10 +231,9 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
         pass->first = done;
         pass->entries = k;
         if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
-        const cl_mem args[11] = {aa->pass,   aa->marks,       r->radiance, aa->film,
-                                 aa->slots,  aa->slot_pixels, aa->levels,  aa->values,
-                                 aa->counts, aa->changed,     aa->split};
-        if (aa_launch(r, r->k_aa_split_store, 0, args, 11, k, &st->aa_reconstruct_ms)) return -1;
+        const cl_mem args[10] = {aa->pass,        aa->marks,  r->radiance, aa->film,   aa->slots,
+                                 aa->slot_pixels, aa->levels, aa->values,  aa->counts, aa->split};
+        if (aa_launch(r, r->k_aa_split_store, 0, args, 10, k, &st->aa_reconstruct_ms)) return -1;
         st->samples += 3ull * k;
         aa_progress(pg, round, level, st->samples, npix, done + k, marked);
     }
@@ -311,9 +308,6 @@ static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba,
              fail);
     CL_CHECK(clEnqueueFillBuffer(d->queue, aa->info, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
                                  0, NULL, NULL),
-             fail);
-    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->changed, &none, sizeof none, 0,
-                                 sizeof(cl_int) * npix, 0, NULL, NULL),
              fail);
     CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
                                   NULL),
@@ -433,9 +427,8 @@ fail:
 
 void aa_release(AaState *aa)
 {
-    cl_mem *mems[] = {&aa->pass,   &aa->film,    &aa->slots,  &aa->info,
-                      &aa->counts, &aa->levels,  &aa->values, &aa->slot_pixels,
-                      &aa->marks,  &aa->changed, &aa->split};
+    cl_mem *mems[] = {&aa->pass,   &aa->film,   &aa->slots,       &aa->info,  &aa->counts,
+                      &aa->levels, &aa->values, &aa->slot_pixels, &aa->marks, &aa->split};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);
