@@ -83,6 +83,10 @@ static const char usage_text[] =
     "      --aa-reconstruct nearest|leaves  a refined pixel is the mean of its 16x16 finest\n"
     "                           cells, each the value of the sample nearest to it\n"
     "                           (default) or of the leaf covering it (the thesis's)\n"
+    "      --aa-pairs first|both  of two adjacent subpixels of one level that fail, split\n"
+    "                           the first in raster order, the other only if it still\n"
+    "                           fails against the first's children (default, the\n"
+    "                           thesis's figure 4.2), or both at once\n"
     "      --bands N|thesis     wavelength bands of a dispersive refraction (1..64), or the\n"
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
@@ -110,8 +114,8 @@ static const char usage_text[] =
 
 /* Command-line settings; a negative or NULL value means "not given". */
 typedef struct Options {
-    const char *scene, *output, *device, *grid, *fresnel, *aa_reconstruct, *aa_map, *aa_samples_map,
-        *stats_json;
+    const char *scene, *output, *device, *grid, *fresnel, *aa_reconstruct, *aa_pairs, *aa_map,
+        *aa_samples_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
@@ -248,7 +252,8 @@ static int option_frames(Options *o, const char *val)
 }
 
 /* The options with a value that need more than a range: --frames, --fresnel, --exposure,
- * --bands, --aa-reconstruct. Returns -1 (stored), 2 (usage error) or -2 (a is none of them). */
+ * --bands, --aa-reconstruct, --aa-pairs. Returns -1 (stored), 2 (usage error) or -2 (a is none of
+ * them). */
 static int option_special(Options *o, const char *a, const char *val)
 {
     if (!strcmp(a, "--frames")) return option_frames(o, val);
@@ -262,6 +267,12 @@ static int option_special(Options *o, const char *a, const char *val)
         if (strcmp(val, "nearest") && strcmp(val, "leaves"))
             return usage_error("--aa-reconstruct %s: expected nearest or leaves", diag_value(val));
         o->aa_reconstruct = val;
+        return -1;
+    }
+    if (!strcmp(a, "--aa-pairs")) {
+        if (strcmp(val, "first") && strcmp(val, "both"))
+            return usage_error("--aa-pairs %s: expected first or both", diag_value(val));
+        o->aa_pairs = val;
         return -1;
     }
     if (!strcmp(a, "--exposure")) {
@@ -281,7 +292,7 @@ static int option_special(Options *o, const char *a, const char *val)
 static int is_special_option(const char *a)
 {
     return !strcmp(a, "--frames") || !strcmp(a, "--fresnel") || !strcmp(a, "--exposure") ||
-           !strcmp(a, "--bands") || !strcmp(a, "--aa-reconstruct");
+           !strcmp(a, "--bands") || !strcmp(a, "--aa-reconstruct") || !strcmp(a, "--aa-pairs");
 }
 
 /* Reads the command line into o. Returns -1 to go on and render, or an exit status (0
@@ -426,6 +437,8 @@ static int apply_options(const Options *o, Scene *s)
     if (o->aa_reconstruct)
         s->aa_reconstruct =
             strcmp(o->aa_reconstruct, "leaves") == 0 ? SCENE_AA_LEAVES : SCENE_AA_NEAREST;
+    if (o->aa_pairs)
+        s->aa_pairs = strcmp(o->aa_pairs, "both") == 0 ? SCENE_AA_PAIRS_BOTH : SCENE_AA_PAIRS_FIRST;
     if (o->no_cone_test) s->shadow_cone_test = 0;
     if (o->no_camera_tiles) s->camera_tiles = 0;
     if (o->all_feelers) s->shadow_by_weight = 0;

@@ -92,9 +92,10 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
     if (!(s->aa_threshold > 0.0f)) return;
     fprintf(f,
             "anti-alias  adaptive quadtree, threshold %g (x %g per level), floor %g, max level %d, "
-            "reconstruct %s, %d rounds; pixels refined to level",
+            "reconstruct %s, pairs %s, %d rounds; pixels refined to level",
             (double)s->aa_threshold, (double)s->aa_level_gain, (double)s->aa_floor, s->aa_max_level,
-            s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves" : "nearest", st->aa_rounds);
+            s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves" : "nearest",
+            s->aa_pairs == SCENE_AA_PAIRS_BOTH ? "both" : "first", st->aa_rounds);
     for (int l = 1; l <= s->aa_max_level; l++)
         fprintf(f, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
                 l < s->aa_max_level ? "," : "\n");
@@ -314,6 +315,7 @@ static void json_samples(cJSON *root, const Scene *s, const RenderStats *st, int
         : s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves"
                                                : "nearest",
         ok);
+    str(o, "pairs", !adaptive ? "none" : s->aa_pairs == SCENE_AA_PAIRS_BOTH ? "both" : "first", ok);
     num(o, "rounds", st->aa_rounds, ok);
     cJSON *a = arr(o, "refined_per_level", ok);
     for (int l = 1; a && adaptive && l <= s->aa_max_level; l++)

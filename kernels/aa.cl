@@ -54,11 +54,23 @@ VB_INLINE size_t aa_cell_value(uint cap, int slot, int lv, int fx, int fy)
     return aa_node_value(cap, slot, lv, fx >> shift, fy >> shift);
 }
 
+/* Whether a leaf whose corner is image cell (X0, Y0) leaves its comparison with an adjacent
+ * leaf of its own level whose corner is (NX0, NY0) to that leaf: with VbAaPass.pairs 0 a
+ * failing pair of one level splits only its first leaf in raster order, as the thesis's
+ * figure 4.2 refines the pixel it scans and then compares again (the second one splits in a
+ * later round if it still fails against the first's children, now deeper than it). Where
+ * the edge lies in the first leaf, the second one's split would only repeat its value. */
+VB_INLINE int aa_pair_left_to(__constant const VbAaPass *aa, int X0, int Y0, int NX0, int NY0)
+{
+    return aa->pairs == 0 && (NY0 < Y0 || (NY0 == Y0 && NX0 < X0));
+}
+
 /* Whether the leaf of s x s cells at (X0, Y0) (image cells), level lv, display value a,
  * fails the contrast test against an adjacent leaf at its level or deeper: the ring of
  * cells around it is walked one adjacent leaf at a time (leaves are aligned squares, so
  * the next leaf along a row starts at the next multiple of the current one's size). An
- * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2).
+ * adjacent leaf at a lower level is not compared: it is the one to split (figure 4.2); one
+ * at the same level that comes first in raster order is not either (aa_pair_left_to).
  * The threshold at level lv is threshold * level_gain^lv: with a gain of 1 the thesis's
  * (every level alike); with 2, an edge's share of its pixel's error, which halves with
  * each level (2^L leaves of 4^-L of the pixel along it), is what is held to the threshold. */
@@ -80,14 +92,14 @@ VB_INLINE int aa_leaf_fails(__constant const VbAaPass *aa, __global const float 
             int fx = X % AA_TREE_SIDE, fy = Y % AA_TREE_SIDE;
             if (slot >= 0)
                 lc = tree.levels[(size_t)slot * VBCL_AA_CELLS + (size_t)(fy * AA_TREE_SIDE + fx)];
-            if (lc >= lv) { /* the value only of a leaf compared */
+            int ls = AA_TREE_SIDE >> lc; /* the adjacent leaf's side, in cells */
+            if (lc > lv || (lc == lv && !aa_pair_left_to(aa, X0, Y0, X / ls * ls, Y / ls * ls))) {
                 float3 c = slot < 0
                                ? vload4(q, film).xyz
                                : vload4(aa_cell_value(tree.cap, slot, lc, fx, fy), tree.values).xyz;
                 if (aa_contrast_fails(a, aa_display(aa, c), threshold, aa->floor)) return 1;
             }
-            int sc = AA_TREE_SIDE >> lc;
-            t = (t / sc + 1) * sc;
+            t = (t / ls + 1) * ls;
         }
     }
     return 0;
@@ -149,7 +161,8 @@ VB_INLINE int aa_leaf_touched(__constant const VbAaPass *aa, __global const uint
 
 /* Whether an unsplit pixel p (x, y), display value a, whose 8 neighbours are all unsplit
  * too fails against one of them: the plain 8-neighbour test of the thesis, all at level 0
- * (the ring walk of aa_leaf_fails gives the same answer, one neighbour at a time). */
+ * (the ring walk of aa_leaf_fails gives the same answer, one neighbour at a time, and
+ * leaves the same neighbours to be compared by their own test: aa_pair_left_to). */
 VB_INLINE int aa_plain_pixel_fails(__constant const VbAaPass *aa, __global const float *film,
                                    __global const int *slots, int x, int y, float3 a,
                                    int *all_plain)
@@ -161,6 +174,7 @@ VB_INLINE int aa_plain_pixel_fails(__constant const VbAaPass *aa, __global const
             int q = qy * aa->width + qx;
             if (q == y * aa->width + x) continue;
             if (slots[q] >= 0) *all_plain = 0;
+            if (aa_pair_left_to(aa, x, y, qx, qy)) continue;
             fails |=
                 aa_contrast_fails(a, aa_display(aa, vload4(q, film).xyz), aa->threshold, aa->floor);
         }

@@ -277,6 +277,8 @@ typedef struct VbAaPass {
     float level_gain;      /* a leaf at level L fails at threshold * level_gain^L */
     int reconstruct;       /* aa_resolve: 0 the nearest samples, 1 the leaves (SCENE_AA_*) */
     unsigned int tree_cap; /* adaptive: the tree slots the levels and values hold (aa_tree.h) */
+    int pairs; /* aa_leaf_fails: a failing pair of leaves of one level splits its first leaf in
+                * raster order (0, the thesis's) or both (1) (SCENE_AA_PAIRS_*) */
 } VbAaPass;
 
 /* Everything a frame's kernels read besides the big buffers. */
@@ -367,7 +369,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
     X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
-    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(VBCL_OFFSETOF(VbAaPass, tree_cap)) X(sizeof(VbSplit))    \
+    X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(VBCL_OFFSETOF(VbAaPass, tree_cap)) X(VBCL_OFFSETOF(VbAaPass, pairs)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
 /* clang-format on */
@@ -430,13 +432,14 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, after) == 80, split_after);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplit, key) == 100, split_key);
 VBCL_STATIC_ASSERT(sizeof(VbSplitSet) == 240, splitset_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbSplitSet, count) == 224, splitset_count);
-VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 52, aapass_size);
+VBCL_STATIC_ASSERT(sizeof(VbAaPass) == 56, aapass_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, side) == 20, aapass_side);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, floor) == 24, aapass_floor);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, first) == 28, aapass_first);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, level_gain) == 40, aapass_level_gain);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, reconstruct) == 44, aapass_reconstruct);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, tree_cap) == 48, aapass_tree_cap);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbAaPass, pairs) == 52, aapass_pairs);
 
 /* The counter list's indices: distinct (their bits' sum equals their union), clear of the
  * reserved index 0 and below the by-depth counters. */

@@ -141,7 +141,10 @@ static int same_pixel(const AaRender *a, const AaRender *b, int i)
 /* RMSE against --ssaa 16 falls as the threshold falls (1.0, 0.4, 0.1, 0.02); threshold 1.0
  * refines nothing (the contrast is at most 1); at 0.1 the samples are at most a twentieth
  * of uniform 16x16 (the quadtree refines only the subpixels along the edges); no pixel
- * takes more than 256 samples (a fully split pixel: its 256 leaves, each traced once). */
+ * takes more than 256 samples (a fully split pixel: its 256 leaves, each traced once). At
+ * 0.1 and 0.02, --aa-pairs both (a failing pair of one level splits both leaves, not only
+ * the first) traces more samples for no less error: on these flat colours the second leaf
+ * of a pair that the edge does not cross gains nothing from its split. */
 static void test_aa_error_falls_with_threshold(void)
 {
     if (!tu_device()) {
@@ -175,6 +178,19 @@ static void test_aa_error_falls_with_threshold(void)
     for (int k = 0; k < 4; k++)
         CHECK(r[k].samples_max <= 256, "threshold %g: %u samples in one pixel", thr[k],
               r[k].samples_max);
+    for (int k = 2; k < 4; k++) {
+        char extra[64], name[32];
+        AaRender both;
+        snprintf(extra, sizeof extra, "--aa %g --aa-pairs both", thr[k]);
+        snprintf(name, sizeof name, "both%d", k);
+        if (aa_render(name, extra, 0, &both)) break;
+        double eb = rmse(&both, &ref);
+        fprintf(stderr, "    %-27s RMSE %.3e  samples/pixel %7.2f\n", extra, eb, both.samples_mean);
+        CHECK(r[k].samples_mean < both.samples_mean && e[k] <= 1.02 * eb,
+              "threshold %g: pairs first %.3f samples/pixel, RMSE %.4e; both %.3f, %.4e", thr[k],
+              r[k].samples_mean, e[k], both.samples_mean, eb);
+        aa_free(&both);
+    }
     aa_free(&ref);
     aa_free(&plain);
     for (int k = 0; k < 4; k++) aa_free(&r[k]);
@@ -260,26 +276,28 @@ static void test_aa_untouched_pixels_unchanged(void)
 }
 
 /* --ssaa 1 goes through the supersampling path and gives the plain render bit for bit;
- * render.aa (and aa_max_level, aa_level_gain, aa_floor, aa_reconstruct) in the scene is
- * the same as the options; the floor's default is 1, the reconstruction's nearest; option
- * errors exit 2. */
+ * render.aa (and aa_max_level, aa_level_gain, aa_floor, aa_reconstruct, aa_pairs) in the
+ * scene is the same as the options; the floor's default is 1, the reconstruction's nearest,
+ * the pairs' first; option errors exit 2. */
 static void test_aa_options(void)
 {
     if (!tu_device()) {
         th_skip("no OpenCL device");
         return;
     }
-    AaRender plain, one, cli, key, dflt, floor1, floor0, nearest, leaves;
+    AaRender plain, one, cli, key, dflt, floor1, floor0, nearest, leaves, first, both;
     if (aa_render("opt_plain", "", 0, &plain) || aa_render("opt_ssaa1", "--ssaa 1", 0, &one) ||
         aa_render("opt_cli",
                   "--aa 0.1 --aa-max-level 3 --aa-level-gain 1.5 --aa-floor 0.5 "
-                  "--aa-reconstruct leaves",
+                  "--aa-reconstruct leaves --aa-pairs both",
                   1, &cli) ||
         aa_render("opt_default", "--aa 0.4", 0, &dflt) ||
         aa_render("opt_floor1", "--aa 0.4 --aa-floor 1", 0, &floor1) ||
         aa_render("opt_floor0", "--aa 0.4 --aa-floor 0", 0, &floor0) ||
         aa_render("opt_nearest", "--aa 0.4 --aa-reconstruct nearest", 0, &nearest) ||
-        aa_render("opt_leaves", "--aa 0.4 --aa-reconstruct leaves", 0, &leaves))
+        aa_render("opt_leaves", "--aa 0.4 --aa-reconstruct leaves", 0, &leaves) ||
+        aa_render("opt_first", "--aa 0.4 --aa-pairs first", 0, &first) ||
+        aa_render("opt_both", "--aa 0.4 --aa-pairs both", 0, &both))
         return;
     CHECK(rmse(&plain, &one) == 0.0, "--ssaa 1 differs from the plain render: %g",
           rmse(&plain, &one));
@@ -290,13 +308,19 @@ static void test_aa_options(void)
     CHECK(rmse(&dflt, &nearest) == 0.0, "the default reconstruction is not nearest: %g",
           rmse(&dflt, &nearest));
     CHECK(rmse(&dflt, &leaves) > 0.0, "--aa-reconstruct leaves changes nothing at --aa 0.4");
+    /* the pairs' default is first, and both splits more */
+    CHECK(rmse(&dflt, &first) == 0.0 && dflt.samples_mean == first.samples_mean,
+          "the default pairs are not first: %g", rmse(&dflt, &first));
+    CHECK(both.samples_mean > first.samples_mean,
+          "--aa-pairs both traces no more samples than first at --aa 0.4: %.3f vs %.3f",
+          both.samples_mean, first.samples_mean);
     /* the scene with render.aa set instead of the option */
     char cmd[2048], log[8192], out[512];
     snprintf(out, sizeof out, "%s/aa_key.exr", tu_tmpdir());
     snprintf(cmd, sizeof cmd,
              "sed 's/\"ambient\": \\[1, 1, 1\\]/\"ambient\": [1, 1, 1], \"aa\": 0.1, "
              "\"aa_max_level\": 3, \"aa_level_gain\": 1.5, \"aa_floor\": 0.5, "
-             "\"aa_reconstruct\": \"leaves\"/' %s > "
+             "\"aa_reconstruct\": \"leaves\", \"aa_pairs\": \"both\"/' %s > "
              "%s/aa_key.json && "
              "%s %s/aa_key.json -q -o %s",
              AA_SCENE, tu_tmpdir(), tu_vbcl, tu_tmpdir(), out);
@@ -317,7 +341,8 @@ static void test_aa_options(void)
                          "--aa 0.1 --aa-map m.bmp",
                          "--aa 0.1 --aa-floor 3",
                          "--aa 0.1 --aa-level-gain 0.5",
-                         "--aa 0.1 --aa-reconstruct mean"};
+                         "--aa 0.1 --aa-reconstruct mean",
+                         "--aa 0.1 --aa-pairs one"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(cmd, sizeof cmd, "%s %s -q -o %s/never.png %s", tu_vbcl, AA_SCENE, tu_tmpdir(),
                  bad[i]);
@@ -333,6 +358,8 @@ static void test_aa_options(void)
     aa_free(&floor0);
     aa_free(&nearest);
     aa_free(&leaves);
+    aa_free(&first);
+    aa_free(&both);
 }
 
 /* Splits leaves[i] of a list of *n quadtree leaves: its three new children are appended and
@@ -460,6 +487,8 @@ typedef struct TwoPixelCase {
     unsigned want[12], nwant;
     float floor; /* the contrast's floor on a + b (0: the thesis's plain ratio) */
     float gain;  /* the threshold's growth per level (1: the thesis's) */
+    int first;   /* 1: a failing pair of one level splits its first leaf in raster order
+                  * (--aa-pairs first, the default); 0: both (--aa-pairs both) */
 } TwoPixelCase;
 
 static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, unsigned nodd,
@@ -497,6 +526,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsign
     pass.height = 1;
     pass.round = round;
     pass.tree_cap = 2;
+    pass.pairs = tc->first ? SCENE_AA_PAIRS_FIRST : SCENE_AA_PAIRS_BOTH;
     /* two rounds' halves: pixel 1's blocks split last round, and two rounds ago (in the
      * half this round clears for its own splits) */
     cl_uint split[4] = {0};
@@ -529,7 +559,9 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsign
 /* The quadtree's neighbour rule across levels and across the pixel border, on the
  * contrast kernel itself with two refined pixels side by side: a leaf is compared with
  * each adjacent leaf of its neighbour at the finer level of the two (8-neighbourhood, so
- * corners count), and of a failing pair the leaf at the lower level splits, both on a tie.
+ * corners count), and of a failing pair the leaf at the lower level splits; on a tie both
+ * with --aa-pairs both, and with first (the default) the one first in raster order (the
+ * row above, or the left one in a row), which is not always the same pixel's on a diagonal.
  * After round 0 only leaves in or next to a block of cells split in the last round are
  * tested: the same cases in round 1 mark the same leaves when all of pixel 1 was split in
  * round 0, nothing when the last split was earlier, and nothing when round 0 split only
@@ -555,7 +587,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 0), P0(1, 1, 1)},
          2,
          0.0f,
-         1.0f},
+         1.0f,
+         0},
         /* one bright level-2 leaf of pixel 1 at the bottom of the border: pixel 0's
          * lower-right leaf splits (pixel 1's other border leaves equal it), its
          * upper-right one does not; inside pixel 1 the bright leaf and its three
@@ -571,7 +604,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 1), P1(2, 0, 3), P1(2, 0, 2), P1(2, 1, 2), P1(2, 1, 3)},
          5,
          0.0f,
-         1.0f},
+         1.0f,
+         0},
         /* a bright leaf higher up, (0, 1) (cells y 4..7): pixel 0's upper-right leaf
          * (y 0..7) meets it along the border, the lower-right one (y 8..15) only through
          * its corner cell (16, 7): both split */
@@ -587,7 +621,8 @@ static void test_aa_neighbour_rule_across_levels(void)
           P1(2, 0, 2)},
          8,
          0.0f,
-         1.0f},
+         1.0f,
+         0},
         /* equal levels: both sides of the border split */
         {"tie",
          1,
@@ -600,7 +635,8 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
          4,
          0.0f,
-         1.0f},
+         1.0f,
+         0},
         /* a dark pair: relative contrast 0.33 splits both sides; with a floor of 0.5 on
          * a + b the difference 0.01 is under 0.1 * 0.5 and nothing splits */
         {"dark pair",
@@ -614,8 +650,9 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
          4,
          0.0f,
-         1.0f},
-        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f, 1.0f},
+         1.0f,
+         0},
+        {"dark pair, floor", 1, 1, 0.01f, 0.02f, 0.02f, {0}, 0, {0}, 0, 0.5f, 1.0f, 0},
         /* the threshold grows by the gain per level: contrast 1/3 fails 0.1 * 2 at level
          * 1 (the tie above, now with gain 2: both sides split) but not 0.1 * 2^2 at level
          * 2, where with the thesis's gain 1 all eight border leaves split */
@@ -630,8 +667,9 @@ static void test_aa_neighbour_rule_across_levels(void)
          {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0), P1(1, 0, 1)},
          4,
          0.0f,
-         2.0f},
-        {"gain 2, level 2", 2, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {0}, 0, 0.0f, 2.0f},
+         2.0f,
+         0},
+        {"gain 2, level 2", 2, 2, 0.5f, 1.0f, 1.0f, {0}, 0, {0}, 0, 0.0f, 2.0f, 0},
         {"gain 1, level 2",
          2,
          2,
@@ -644,9 +682,57 @@ static void test_aa_neighbour_rule_across_levels(void)
           P1(2, 0, 3)},
          8,
          0.0f,
-         1.0f},
+         1.0f,
+         0},
         /* below the threshold nothing splits */
-        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f, 1.0f},
+        {"no contrast", 2, 1, 0.5f, 0.55f, 0.55f, {0}, 0, {0}, 0, 0.0f, 1.0f, 0},
+        /* --aa-pairs first: of the tie's pairs across the border, pixel 0's upper leaf
+         * (corner cell (8, 0)) comes before both of pixel 1's (16, 0) and (16, 8); its lower
+         * one (8, 8) before (16, 8) but after (16, 0), which splits instead */
+        {"tie, first",
+         1,
+         1,
+         0.5f,
+         1.0f,
+         1.0f,
+         {0},
+         0,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(1, 0, 0)},
+         3,
+         0.0f,
+         1.0f,
+         1},
+        /* inside pixel 1 the bright leaf (0, 3) splits before its right neighbour (1, 3),
+         * and after (0, 2) and (1, 2) in the row above, which split instead; pixel 0's
+         * coarser leaf splits as before */
+        {"one subpixel, first",
+         1,
+         2,
+         0.5f,
+         0.5f,
+         1.0f,
+         {P1(2, 0, 3) & 0xffff},
+         1,
+         {P0(1, 1, 1), P1(2, 0, 3), P1(2, 0, 2), P1(2, 1, 2)},
+         4,
+         0.0f,
+         1.0f,
+         1},
+        /* the bright leaf (0, 1): (0, 0) and (1, 0) above it split, and it splits before
+         * (1, 1), (1, 2) and (0, 2), which wait */
+        {"corner, first",
+         1,
+         2,
+         0.5f,
+         0.5f,
+         1.0f,
+         {P1(2, 0, 1) & 0xffff},
+         1,
+         {P0(1, 1, 0), P0(1, 1, 1), P1(2, 0, 1), P1(2, 0, 0), P1(2, 1, 0)},
+         5,
+         0.0f,
+         1.0f,
+         1},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         two_pixel_run(&fx, &cases[i], 0, 0u, 0u);

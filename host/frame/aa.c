@@ -325,6 +325,7 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     pass->floor = s->aa_floor;
     pass->level_gain = s->aa_level_gain;
     pass->reconstruct = s->aa_reconstruct;
+    pass->pairs = s->aa_pairs;
     pass->contrast_scale = exp2f(s->exposure);
     pass->max_level = s->aa_max_level;
     pass->width = s->width;

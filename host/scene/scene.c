@@ -226,10 +226,11 @@ static int get_choice(Ctx *c, const cJSON *j, const char *key, const char *name0
 }
 
 /* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain,
- * render.aa_reconstruct: adaptive anti-aliasing. */
+ * render.aa_reconstruct, render.aa_pairs: adaptive anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
     return get_choice(c, j, "aa_reconstruct", "nearest", "leaves", &s->aa_reconstruct) ||
+           get_choice(c, j, "aa_pairs", "first", "both", &s->aa_pairs) ||
            json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
            json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
                         &s->aa_max_level) ||
@@ -252,6 +253,34 @@ static int get_bool(Ctx *c, const cJSON *j, const char *key, int *v)
     return 0;
 }
 
+/* render's defaults, every key absent. */
+static void render_defaults(Scene *s, const float amb[3])
+{
+    s->max_depth = 6;
+    s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
+    s->subgrid_density = GRID_SUB_DEFAULT_DENSITY;
+    s->shadow_samples = 16;
+    memcpy(s->ambient, amb, sizeof s->ambient);
+    s->seed = 1;
+    s->fresnel = SCENE_FRESNEL_EXACT;
+    s->min_weight = 1e-3f;
+    s->aa_threshold = 0.0f;
+    s->aa_max_level = VBCL_AA_MAX_LEVEL;
+    s->aa_floor = SCENE_AA_FLOOR;
+    s->aa_level_gain = SCENE_AA_LEVEL_GAIN;
+    s->aa_reconstruct = SCENE_AA_NEAREST;
+    s->aa_pairs = SCENE_AA_PAIRS_FIRST;
+    s->ssaa = 1;
+    s->bands = 8;
+    s->band_layout = DISP_LAYOUT_UNIFORM;
+    s->shadow_jitter = 1;
+    s->shadow_cone_test = 1;
+    s->camera_tiles = 1;
+    s->shadow_by_weight = 1;
+    s->sample_shares = 1;
+    s->penumbra_feelers = SCENE_PENUMBRA_FEELERS;
+}
+
 static int load_render(Ctx *c, const cJSON *j, Scene *s)
 {
     static const char *const keys[] = {"max_depth",
@@ -267,6 +296,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "aa_floor",
                                        "aa_level_gain",
                                        "aa_reconstruct",
+                                       "aa_pairs",
                                        "bands",
                                        "shadow_jitter",
                                        "subgrid",
@@ -278,28 +308,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "penumbra_feelers",
                                        NULL};
     static const float amb[3] = {0.1f, 0.1f, 0.1f};
-    s->max_depth = 6;
-    s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
-    s->subgrid_density = GRID_SUB_DEFAULT_DENSITY;
-    s->shadow_samples = 16;
-    memcpy(s->ambient, amb, sizeof amb);
-    s->seed = 1;
-    s->fresnel = SCENE_FRESNEL_EXACT;
-    s->min_weight = 1e-3f;
-    s->aa_threshold = 0.0f;
-    s->aa_max_level = VBCL_AA_MAX_LEVEL;
-    s->aa_floor = SCENE_AA_FLOOR;
-    s->aa_level_gain = SCENE_AA_LEVEL_GAIN;
-    s->aa_reconstruct = SCENE_AA_NEAREST;
-    s->ssaa = 1;
-    s->bands = 8;
-    s->band_layout = DISP_LAYOUT_UNIFORM;
-    s->shadow_jitter = 1;
-    s->shadow_cone_test = 1;
-    s->camera_tiles = 1;
-    s->shadow_by_weight = 1;
-    s->sample_shares = 1;
-    s->penumbra_feelers = SCENE_PENUMBRA_FEELERS;
+    render_defaults(s, amb);
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;

@@ -53,6 +53,12 @@ enum { SCENE_FRESNEL_EXACT = 0, SCENE_FRESNEL_THESIS = 1 };
  * of the leaves). The values are VbAaPass.reconstruct's. */
 enum { SCENE_AA_NEAREST = 0, SCENE_AA_LEAVES = 1 };
 
+/* Which node of a failing pair of adjacent leaves at the same level splits (render.aa_pairs):
+ * the first in raster order, the other only if the pair still fails against the first's
+ * children (the thesis's figure 4.2, one pixel at a time), or both at once. The values are
+ * VbAaPass.pairs'. */
+enum { SCENE_AA_PAIRS_FIRST = 0, SCENE_AA_PAIRS_BOTH = 1 };
+
 /* render.aa_floor's default: the least a + b of the contrast test (display units). */
 #define SCENE_AA_FLOOR 1.0f
 /* render.aa_level_gain's default: the threshold grows by this factor per level. */
@@ -104,6 +110,7 @@ typedef struct Scene {
     float aa_floor;       /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
     float aa_level_gain;  /* a leaf at level L fails at aa_threshold * gain^L (1: the thesis) */
     int aa_reconstruct;   /* SCENE_AA_NEAREST or SCENE_AA_LEAVES */
+    int aa_pairs;         /* SCENE_AA_PAIRS_FIRST or SCENE_AA_PAIRS_BOTH */
     int ssaa;             /* uniform N x N supersampling (command line only); 1: off */
     int bands;            /* render.bands: wavelength bands of a dispersive split */
     int band_layout;      /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
