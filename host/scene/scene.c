@@ -253,14 +253,17 @@ static int get_bool(Ctx *c, const cJSON *j, const char *key, int *v)
     return 0;
 }
 
+/* render.ambient's default. */
+static const float render_ambient[3] = {0.1f, 0.1f, 0.1f};
+
 /* render's defaults, every key absent. */
-static void render_defaults(Scene *s, const float amb[3])
+static void render_defaults(Scene *s)
 {
     s->max_depth = 6;
     s->grid_density = 0.0f; /* the default of the grid's kind: grid_build_levels */
     s->subgrid_density = GRID_SUB_DEFAULT_DENSITY;
     s->shadow_samples = 16;
-    memcpy(s->ambient, amb, sizeof s->ambient);
+    memcpy(s->ambient, render_ambient, sizeof s->ambient);
     s->seed = 1;
     s->fresnel = SCENE_FRESNEL_EXACT;
     s->min_weight = 1e-3f;
@@ -307,8 +310,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "sample_shares",
                                        "penumbra_feelers",
                                        NULL};
-    static const float amb[3] = {0.1f, 0.1f, 0.1f};
-    render_defaults(s, amb);
+    render_defaults(s);
     if (!j) return 0; /* absent: all defaults */
     if (json_expect_object(c, j, "render") || json_check_keys(c, j, "render", keys)) return -1;
     int seed;
@@ -317,7 +319,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
         json_get_float(c, j, "render", "subgrid_density", 0.01, 64, GRID_SUB_DEFAULT_DENSITY, 0,
                        &s->subgrid_density) ||
         json_get_int(c, j, "render", "shadow_samples", 1, 1024, 16, 0, &s->shadow_samples) ||
-        json_get_rgb(c, j, "render", "ambient", amb, s->ambient) ||
+        json_get_rgb(c, j, "render", "ambient", render_ambient, s->ambient) ||
         json_get_int(c, j, "render", "seed", 0, 0x7fffffff, 1, 0, &seed) ||
         json_get_float(c, j, "render", "min_weight", 0, 1, 1e-3, 0, &s->min_weight) ||
         json_get_int(c, j, "render", "penumbra_feelers", 1, SCENE_PENUMBRA_FEELERS_MAX,
