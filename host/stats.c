@@ -78,6 +78,18 @@ static void print_tree(FILE *f, const Scene *s, const RenderStats *st)
     fputc('\n', f);
 }
 
+/* The names of the adaptive anti-aliasing's reconstruction and pair rule, as the options and
+ * scene keys spell them (--aa-reconstruct, --aa-pairs). */
+static const char *aa_reconstruct_name(const Scene *s)
+{
+    return s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves" : "nearest";
+}
+
+static const char *aa_pairs_name(const Scene *s)
+{
+    return s->aa_pairs == SCENE_AA_PAIRS_BOTH ? "both" : "first";
+}
+
 /* samples per pixel and anti-aliasing */
 static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
 {
@@ -94,8 +106,7 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
             "anti-alias  adaptive quadtree, threshold %g (x %g per level), floor %g, max level %d, "
             "reconstruct %s, pairs %s, %d rounds; pixels refined to level",
             (double)s->aa_threshold, (double)s->aa_level_gain, (double)s->aa_floor, s->aa_max_level,
-            s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves" : "nearest",
-            s->aa_pairs == SCENE_AA_PAIRS_BOTH ? "both" : "first", st->aa_rounds);
+            aa_reconstruct_name(s), aa_pairs_name(s), st->aa_rounds);
     for (int l = 1; l <= s->aa_max_level; l++)
         fprintf(f, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
                 l < s->aa_max_level ? "," : "\n");
@@ -310,12 +321,8 @@ static void json_samples(cJSON *root, const Scene *s, const RenderStats *st, int
     fnum(o, "floor", adaptive ? s->aa_floor : 0.0f, ok);
     fnum(o, "level_gain", adaptive ? s->aa_level_gain : 0.0f, ok);
     num(o, "max_level", adaptive ? s->aa_max_level : 0, ok);
-    str(o, "reconstruct",
-        !adaptive                              ? "none"
-        : s->aa_reconstruct == SCENE_AA_LEAVES ? "leaves"
-                                               : "nearest",
-        ok);
-    str(o, "pairs", !adaptive ? "none" : s->aa_pairs == SCENE_AA_PAIRS_BOTH ? "both" : "first", ok);
+    str(o, "reconstruct", adaptive ? aa_reconstruct_name(s) : "none", ok);
+    str(o, "pairs", adaptive ? aa_pairs_name(s) : "none", ok);
     num(o, "rounds", st->aa_rounds, ok);
     cJSON *a = arr(o, "refined_per_level", ok);
     for (int l = 1; a && adaptive && l <= s->aa_max_level; l++)
