@@ -251,6 +251,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
 {
     os->n = -1;
     os->sole = -1;
+    os->shell = -1;
     if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return;
     os->n = 0;
     os->tris = 0u;
@@ -300,6 +301,188 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
         }
     }
     os->sole = owners;
+}
+
+/* Whether a ray of cone k (a cone of half-angle 0: ray_objects; inv = 1 / k->axis) can meet
+ * a triangle that record ob bounds: light_cone_meets for such a cone, the box tested once
+ * along the whole stretch (the four pieces of light_cone_meets_box are one when the cone
+ * has no width). */
+VB_INLINE int ray_meets(const LightCone *k, float3 inv, __global const VbObject *ob)
+{
+    float4 b = vload4(0, ob->bound);
+    if (b.w < 0.0f) return 0;
+    float3 v = b.xyz - k->o;
+    float along = dot(v, k->axis);
+    float3 q = v - along * k->axis;
+    float3 aq = fabs(q);
+    /* the margin of light_cone_meets, with |q| bounded by the sum of its components */
+    float m = b.w + 1e-5f * (k->d + fabs(along) + aq.x + aq.y + aq.z + b.w);
+    if (along < -m || along > k->d + m || dot(q, q) > m * m) return 0;
+    float mb = m - b.w;
+    float3 lo = vload3(0, ob->lo) - mb, hi = vload3(0, ob->hi) + mb;
+    int3 flat = isless(fabs(k->axis), (float3)(1e-12f));
+    float3 t0 = (lo - k->o) * inv, t1 = (hi - k->o) * inv;
+    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
+    int3 inside = isgreaterequal(k->o, lo) & islessequal(k->o, hi);
+    tn = select(tn, select((float3)(INFINITY), (float3)(-INFINITY), inside), flat);
+    tf = select(tf, select((float3)(-INFINITY), (float3)(INFINITY), inside), flat);
+    if (fmax(fmax(tn.x, tn.y), fmax(tn.z, -mb)) > fmin(fmin(tf.x, tf.y), fmin(tf.z, k->d + mb)))
+        return 0;
+    if (ob->flags & VBCL_OBJECT_PLANAR) {
+        float4 pl = vload4(0, ob->plane);
+        float e = ob->plane_eps + 1e-6f * k->reach;
+        float so = dot(pl.xyz, k->o) - pl.w, sl = dot(pl.xyz, k->c) - pl.w;
+        if ((so > e && sl > e) || (so < -e && sl < -e)) return 0;
+    }
+    return 1;
+}
+
+/* Adds the parts of record ob's texture that a ray of cone k meets (ray_meets) to the set:
+ * a small one's triangles, a bigger one as big. 0 where the set overflows. */
+VB_INLINE int ray_parts(const DevScene *scn, const LightCone *k, float3 inv,
+                        __global const VbObject *ob, ObjectSet *os)
+{
+    for (uint e = ob->first_elem; e < ob->first_elem + ob->nelems; e++) {
+        __global const VbObject *el = scn->objects + e;
+        if (!ray_meets(k, inv, el)) continue;
+        if (el->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 ? !object_set_add(os, el->quad_tri, el->ntris)
+                                                      : !object_set_big(os, e))
+            return 0;
+    }
+    return 1;
+}
+
+/* Where the line from org along the unit direction whose inverse is inv lies in the grid's
+ * box, which holds every triangle: (enter, leave); *m gets a margin for their rounding. */
+VB_INLINE float2 ray_grid_box(const DevScene *scn, float3 org, float3 inv, float *m)
+{
+    float3 lo = vb_cload3(scn->f->grid.lo), hi = vb_cload3(scn->f->grid.hi);
+    float3 t0 = (lo - org) * inv, t1 = (hi - org) * inv;
+    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
+    /* NaN (0 * inf: the ray in a slab's plane) must not narrow the interval */
+    float enter =
+        fmax(isnan(tn.x) ? 0.0f : tn.x, fmax(isnan(tn.y) ? 0.0f : tn.y, isnan(tn.z) ? 0.0f : tn.z));
+    float leave = fmin(isnan(tf.x) ? INFINITY : tf.x,
+                       fmin(isnan(tf.y) ? INFINITY : tf.y, isnan(tf.z) ? INFINITY : tf.z));
+    *m = 1e-4f * (fabs(leave) + vb_max3(fabs(org)) + vb_max3(hi - lo));
+    return (float2)(enter, leave);
+}
+
+/* The object a ray from org along the unit axis leaves behind, starting on triangle tri
+ * (-1: none): that triangle's object where the ray moves away from the triangle's plane,
+ * on the side it starts on (a reflection about a smooth normal can turn back in), and the
+ * triangle is the object's own, not a texture element's (whose surface is not its host's,
+ * as in shade_point_make); else -1. *front: the ray leaves to the triangle's outer side. */
+VB_INLINE int ray_start_object(const DevScene *scn, float3 org, float3 axis, int tri, int *front)
+{
+    *front = 0;
+    if (tri < 0) return -1;
+    float3 a = tri_vertex(scn->tris, tri, 0).xyz;
+    float3 n = cross(tri_vertex(scn->tris, tri, 1).xyz - a, tri_vertex(scn->tris, tri, 2).xyz - a);
+    float along = dot(n, axis), side = dot(n, org - a);
+    uint tag = tri_tag(scn->tris, tri);
+    if (!((along > 0.0f && side > 0.0f) || (along < 0.0f && side < 0.0f)) ||
+        (tag & VBCL_TAG_TEXTURE))
+        return -1;
+    *front = along > 0.0f;
+    return (int)(tag & ~VBCL_TAG_FLAGS);
+}
+
+/* The triangles that a ray of a ray tree, from org along dir, leaving triangle tri (-1:
+ * none) and inside host `host` (VbMedium.host, -1: none), can meet (VBCL_FRAME_CONE_TEST,
+ * as for feelers): those of the objects whose bounds the ray meets (ray_meets) between org
+ * and where it leaves the grid's box, which holds every triangle. A small object's
+ * triangles (and its texture's, where that has no parts and fits) are tested alone; a
+ * bigger one is big: the grid is walked where the ray lies in its bounding sphere
+ * (os->walk, object_set_span), its texture included. Parts of a texture are taken one by
+ * one only where the object's own triangles are settled otherwise: a ray that goes on
+ * counts every texture surface it crosses in its medium (medium_cross), also outside the
+ * host, so no part it meets may be left out. A ray that moves away from its triangle's
+ * plane, on the side it starts on, cannot meet a planar start object again, nor a convex
+ * one it leaves to the outer side: their own triangles are left out (all of them lie
+ * behind that plane). A ray inside a big convex host (VBCL_OBJECT_INNER), having entered it
+ * through one of its own triangles, meets them again only on its way out, beyond the
+ * host's inner sphere: the host is the set's shell, walked only there; and where every way
+ * out of the host is an interface (its material and its texture's both differ from the
+ * air's) the search ends where the ray leaves the host, since medium_trace stops at the
+ * first interface. Any other ray inside a host walks the grid. Returns the distance along
+ * dir beyond which nothing need be searched (with a margin; 0 where the ray misses the box,
+ * the set then empty), INFINITY with os->n = -1 (the grid) where the test is off or the set
+ * overflows; medium_trace within that distance through the set follows the ray as through
+ * the grid. */
+VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri, int host,
+                            ObjectSet *os)
+{
+    os->n = -1;
+    os->sole = -1;
+    os->shell = -1;
+    if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return INFINITY;
+    float len = length(dir);
+    float3 axis = dir / len;
+    float3 inv = (float3)(1.0f) / axis;
+    float m;
+    float2 box = ray_grid_box(scn, org, inv, &m);
+    int front;
+    int object = ray_start_object(scn, org, axis, tri, &front);
+    /* inside a host, only a big convex one's own triangles are settled without the grid
+     * (its shell; a small host's few are no cheaper in a set, measured on A.4), and only for
+     * a ray that enters it through one of them (offset inward: surely inside it; one from a
+     * texture's surface near the host's may lie a rounding outside) */
+    if (host >= 0 && (object != host || front || !(scn->objects[host].flags & VBCL_OBJECT_INNER)))
+        return INFINITY;
+    os->n = 0;
+    os->tris = 0u;
+    os->nbig = 0;
+    os->walk = 0;
+    if (!(box.x <= box.y + m && box.y >= -m)) return 0.0f; /* it misses the box */
+    LightCone k;
+    k.o = org;
+    k.axis = axis;
+    k.d = fmax(box.y, 0.0f) + m;
+    if (host >= 0) {
+        /* a ray inside a convex host whose every way out is an interface ends its search
+         * where it leaves the host (medium_trace stops at the first interface) */
+        __global const VbObject *ho = scn->objects + host;
+        uint air = scn->f->air_material;
+        if ((ho->flags & VBCL_OBJECT_HULL) && ho->material != air && ho->tex_material != air) {
+            float2 st = object_hull_stretch(scn, ho, org, axis, k.d, m);
+            if (st.x <= st.y) k.d = fmin(k.d, fmax(st.y, 0.0f) + m);
+        }
+    }
+    k.c = org + k.d * axis;
+    k.r = 0.0f;
+    k.sin_t = 0.0f;
+    k.cos_t = 1.0f;
+    k.reach = vb_max3(fabs(k.o)) + vb_max3(fabs(k.c));
+    for (uint i = 0; i < scn->f->nobjects; i++) {
+        __global const VbObject *ob = scn->objects + i;
+        uint flags = ob->flags;
+        if ((int)i == host) { /* inside it: its own triangles as a shell */
+            os->shell = (int)i;
+            if (ob->nelems > 0u ? !ray_parts(scn, &k, inv, ob, os)
+                                : ob->ntex > 0u && (ob->quad_tex == VBCL_NO_QUADS ||
+                                                    !object_set_add(os, ob->quad_tex, ob->ntex)))
+                return INFINITY;
+            continue;
+        }
+        int own =
+            (int)i == object && ((flags & VBCL_OBJECT_PLANAR) ||
+                                 ((flags & (VBCL_OBJECT_CONVEX | VBCL_OBJECT_HULL)) && front));
+        if (own && ob->ntex == 0u) continue;
+        if (!ray_meets(&k, inv, ob)) continue;
+        if (own && ob->nelems > 0u) { /* its own triangles left behind: the parts */
+            if (!ray_parts(scn, &k, inv, ob, os)) return INFINITY;
+            continue;
+        }
+        int small = !own && ob->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 &&
+                    (ob->ntex == 0u || ob->quad_tex != VBCL_NO_QUADS);
+        if (small ? !object_set_add(os, ob->quad_tri, ob->ntris) ||
+                        !object_set_add(os, ob->quad_tex, ob->ntex)
+                  : !object_set_big(os, i))
+            return INFINITY;
+    }
+    os->walk = os->nbig > 0 || os->shell >= 0;
+    return k.d / len;
 }
 
 /* What feeler (w, t) from origin lets through, where the point's cone gave set os (and

@@ -79,16 +79,18 @@ typedef struct PathHit {
 } PathHit;
 
 /* Follows (org, dir) through pass-through crossings (updating *state and counting them)
- * to the first interface within tmax. Returns 0 when there is none. camera: a camera ray,
- * whose first search is camera_trace_closest. */
-VB_INLINE int medium_trace(const DevScene *sc, float3 org, float3 dir, float tmax, VbMedium *state,
-                           PathHit *out, TraceCount *tc, uint *passes, int camera)
+ * to the first interface within tmax, among the triangles of os (os->n < 0: any, through
+ * the grid; a set holds for every stretch of the ray). Returns 0 when there is none.
+ * camera: a camera ray, whose first search is camera_trace_closest. */
+VB_INLINE int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+                           float tmax, VbMedium *state, PathHit *out, TraceCount *tc, uint *passes,
+                           int camera)
 {
     float3 o = org;
     for (int guard = 0; guard < 1024; guard++) {
         float done = dot(o - org, dir);
         VbHit h = camera && guard == 0 ? camera_trace_closest(sc, o, dir, tmax - done, tc)
-                                       : scene_trace_closest(sc, o, dir, tmax - done, tc);
+                                       : scene_trace_closest_in(sc, os, o, dir, tmax - done, tc);
         if (h.tri < 0) return 0;
         float3 p = tri_point(sc->tris, h);
         Crossing c = medium_cross(sc, h.tri, dir, *state);

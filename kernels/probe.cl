@@ -510,7 +510,8 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
     TreeCount cnt = {0};
     cnt.prune_budget = 0.0f;
     int k = 0;
-    if (medium_trace(&sc, org, dir, INFINITY, &state, &ph, &tc, &cnt.passes, 0)) {
+    ObjectSet all = object_set_all();
+    if (medium_trace(&sc, &all, org, dir, INFINITY, &state, &ph, &tc, &cnt.passes, 0)) {
         TreeRay stack[VB_TREE_STACK];
         int n = 0;
         ShadePoint sp = shade_point_make(&sc, dir, ph.hit, 1u, state, ph.cx.surface);
@@ -518,7 +519,7 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
         while (n > 0) {
             TreeRay tr = stack[--n];
             VbMedium st = tr.medium;
-            if (!medium_trace(&sc, tr.org, tr.dir, INFINITY, &st, &ph, &tc, &cnt.passes, 0)) {
+            if (!tree_trace(&sc, &tr, &st, &ph, &tc, &cnt.passes)) {
                 if (k < cap) {
                     vstore4((float4)(tr.dir, (float)tr.band), 0, out + 8 * k);
                     vstore4((float4)(tr.weight, (float)tr.depth), 0, out + 8 * k + 4);
@@ -536,16 +537,92 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
 }
 #endif
 
+#ifdef VBCL_HAS_TRANSPARENCY
+/* The object sets of ray-tree rays (ray_objects) against the grid. cases as
+ * probe_cone_brute's (a point, its object, its normal on the viewer's side, its triangle's
+ * scale and index), and in [14] the host of the viewer's side, in [15] the host of the other
+ * side (-1: none) -> out: bits 0-15 how many of nrays rays from the point (directions
+ * uniform over the sphere, each from the side it leaves to, but every fourth from the other
+ * side, as a reflection about a smooth normal can turn back in) follow a different way
+ * through medium_trace with their set than through the grid: another first interface,
+ * distance, medium state or count of pass-through crossings, bit for bit; bits 16-21 which
+ * of the set's ways some ray took: 16 a set (not the grid), 17 a shell host
+ * (VBCL_OBJECT_INNER), 18 a search cut where the ray leaves its convex host (a shorter
+ * reach than the grid's box), 19 its own object left behind (the start triangle's, convex
+ * or planar, and the ray moving away from it), 20 a big record walked, 21 a set whose
+ * ranges and walk found the interface; bits 22-31 a wrong ray's index + 1. */
+__kernel void probe_ray_objects(SCENE_KERNEL_ARGS __global const float *cases, int ncases,
+                                int nrays, __global uint *out)
+{
+    int i = get_global_id(0);
+    if (i >= ncases) return;
+    DevScene sc = DEV_SCENE;
+    __global const float *cs = cases + 16 * i;
+    float3 p = vload3(0, cs), n = normalize(vload3(0, cs + 4));
+    int tri = (int)cs[13];
+    float scale = cs[12];
+    float3 a = tri_vertex(sc.tris, tri, 0).xyz;
+    float3 nt = cross(tri_vertex(sc.tris, tri, 1).xyz - a, tri_vertex(sc.tris, tri, 2).xyz - a);
+    uint tag = tri_tag(sc.tris, tri);
+    __global const VbObject *ob = objects + (tag & ~VBCL_TAG_FLAGS);
+    int planar_or_convex =
+        !(tag & VBCL_TAG_TEXTURE) &&
+        (ob->flags & (VBCL_OBJECT_PLANAR | VBCL_OBJECT_CONVEX | VBCL_OBJECT_HULL));
+    uint wrong = 0u, flags = 0u, first = 0u;
+    for (int k = 0; k < nrays; k++) {
+        uint h1 = vb_hash((uint)(i * nrays + k) * 2u + 1u), h2 = vb_hash(h1 + 0x9e3779b9u);
+        float z = 2.0f * ((float)(h1 >> 8) * (1.0f / 16777216.0f)) - 1.0f;
+        float phi = 2.0f * VB_PI * ((float)(h2 >> 8) * (1.0f / 16777216.0f));
+        float rr = sqrt(fmax(0.0f, 1.0f - z * z));
+        float3 w = (float3)(rr * cos(phi), rr * sin(phi), z);
+        float s = dot(w, n) >= 0.0f ? 1.0f : -1.0f;
+        if ((k & 3) == 3) s = -s; /* turned back */
+        float3 o = ray_offset_origin(p, s * n, scale);
+        VbMedium m0 = {s > 0.0f ? (int)cs[14] : (int)cs[15], 0u};
+        ObjectSet os;
+        float reach = ray_objects(&sc, o, w, tri, m0.host, &os);
+        ObjectSet all = object_set_all();
+        VbMedium sa = m0, sb = m0;
+        PathHit pa, pb;
+        TraceCount tc = {0, 0};
+        uint na = 0u, nb = 0u;
+        int ha = medium_trace(&sc, &os, o, w, reach, &sa, &pa, &tc, &na, 0);
+        int hb = medium_trace(&sc, &all, o, w, INFINITY, &sb, &pb, &tc, &nb, 0);
+        int bad = ha != hb || sa.host != sb.host || sa.tex_counts != sb.tex_counts || na != nb ||
+                  (ha && (pa.hit.tri != pb.hit.tri || pa.dist != pb.dist));
+        if (bad && !first) first = (uint)k + 1u;
+        wrong += (uint)bad;
+        if (os.n < 0) continue;
+        flags |= 1u;
+        flags |= os.shell >= 0 ? 2u : 0u;
+        if (m0.host >= 0 && (objects[m0.host].flags & VBCL_OBJECT_HULL)) {
+            float3 lo = vb_cload3(f->grid.lo), hi = vb_cload3(f->grid.hi);
+            float3 t0 = (lo - o) / w, t1 = (hi - o) / w;
+            float3 tf = fmax(t0, t1);
+            flags |= reach < 0.5f * fmin(tf.x, fmin(tf.y, tf.z)) ? 4u : 0u;
+        }
+        flags |= planar_or_convex && dot(nt, w) > 0.0f && dot(nt, o - a) > 0.0f ? 8u : 0u;
+        flags |= os.nbig > 0 ? 16u : 0u;
+        flags |= ha ? 32u : 0u;
+    }
+    out[i] = min(wrong, 0xffffu) | flags << 16 | min(first, 1023u) << 22;
+}
+#endif
+
 /* ---- The ray-throughput bench (tests/bench/bench_rays.c, `make bench` part "embree") ----
  * Each kernel runs the renderer's own device functions on rays the bench picks, so that a
  * change to the traversal or to the shading path's feelers is measured without editing the
  * bench. Point lists hold indices of primary rays whose first interfaces (hits, media) came
  * from scene_intersect_closest, as in a frame. */
 
-/* rays -> hits: the closest hit of each ray through the grid (scene_trace_closest), or with
- * camera set as the renderer finds a camera ray's (camera_trace_closest: its image tile). */
+/* rays -> hits: the closest hit of each ray as the renderer finds it: mode 0 through the
+ * grid (scene_trace_closest); 1 a camera ray's (camera_trace_closest: its image tile); 2 a
+ * ray tree's ray, which leaves triangle r.sample (probe_secondary_rays), among the triangles
+ * it can meet (ray_objects, scene_trace_closest_in). Such a ray is inside the host whose
+ * triangle it leaves inward, else outside every host, as a ray is that leaves the surface
+ * of a host seen from outside (the bench's secondary rays do). */
 __kernel void probe_trace_closest(SCENE_KERNEL_ARGS __global const VbRay *rays, int nrays,
-                                  __global VbHit *hits, int camera)
+                                  __global VbHit *hits, int mode)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
@@ -553,8 +630,21 @@ __kernel void probe_trace_closest(SCENE_KERNEL_ARGS __global const VbRay *rays, 
     VbRay r = rays[i];
     TraceCount tc = {0, 0};
     float3 org = vb_load3(r.org), dir = vb_load3(r.dir);
-    hits[i] = camera ? camera_trace_closest(&sc, org, dir, r.tmax, &tc)
-                     : scene_trace_closest(&sc, org, dir, r.tmax, &tc);
+    if (mode == 2) {
+        int tri = (int)r.sample;
+        uint tag = tri_tag(sc.tris, tri);
+        __global const VbObject *ob = sc.objects + (tag & ~VBCL_TAG_FLAGS);
+        int host = !(tag & VBCL_TAG_TEXTURE) && (ob->flags & VBCL_OBJECT_HOST) &&
+                           dot(tri_normal(sc.tris, tri), dir) < 0.0f
+                       ? (int)(tag & ~VBCL_TAG_FLAGS)
+                       : -1;
+        ObjectSet os;
+        float reach = ray_objects(&sc, org, dir, tri, host, &os);
+        hits[i] = scene_trace_closest_in(&sc, &os, org, dir, fmin(r.tmax, reach), &tc);
+        return;
+    }
+    hits[i] = mode == 1 ? camera_trace_closest(&sc, org, dir, r.tmax, &tc)
+                        : scene_trace_closest(&sc, org, dir, r.tmax, &tc);
 }
 
 /* rays -> 1 where something lies on the ray before tmax (scene_trace_any), else 0. */
@@ -772,8 +862,8 @@ __kernel void probe_feeler_walk(SCENE_KERNEL_ARGS __global const VbRay *feelers,
 #ifdef VBCL_HAS_TRANSPARENCY
 /* points (primary rays whose first interface is a dielectric) -> the reflected and
  * transmitted rays tree_spawn pushes there, as tree_trace_secondary starts a tree: two
- * slots per point, tmax INFINITY, sample the point's primary ray or 0xffffffff (slot unused;
- * with dispersion only the first two of the bands are kept). */
+ * slots per point, tmax INFINITY, sample the triangle the ray leaves from (TreeRay.tri) or
+ * 0xffffffff (slot unused; with dispersion only the first two of the bands are kept). */
 __kernel void probe_secondary_rays(SCENE_KERNEL_ARGS __global const VbRay *rays,
                                    __global const VbHit *hits, __global const VbMedium *media,
                                    __global const uint *points, int npoints, __global VbRay *out)
@@ -796,7 +886,8 @@ __kernel void probe_secondary_rays(SCENE_KERNEL_ARGS __global const VbRay *rays,
                -1, 0);
     for (int k = 0; k < 2; k++) {
         if (k < n)
-            probe_store_ray(out + 2 * j + k, stack[k].org, stack[k].dir, INFINITY, (uint)i);
+            probe_store_ray(out + 2 * j + k, stack[k].org, stack[k].dir, INFINITY,
+                            (uint)stack[k].tri);
         else
             probe_store_ray(out + 2 * j + k, (float3)(0.0f), (float3)(0.0f, 0.0f, 1.0f), 0.0f,
                             0xffffffffu);

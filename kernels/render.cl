@@ -139,10 +139,11 @@ __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
     PathHit ph;
     uint passes = 0;
     VbHit miss = {r.tmax, -1, 0.0f, 0.0f};
-    hits[i] =
-        medium_trace(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph, &tc, &passes, 1)
-            ? ph.hit
-            : miss;
+    ObjectSet all = object_set_all();
+    hits[i] = medium_trace(&sc, &all, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph, &tc,
+                           &passes, 1)
+                  ? ph.hit
+                  : miss;
     media[i] = state;
     if (passes) atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], passes);
 #else
@@ -223,7 +224,7 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share
         TreeRay tr = stack[--n];
         VbMedium state = tr.medium;
         PathHit ph;
-        if (!medium_trace(sc, tr.org, tr.dir, INFINITY, &state, &ph, tc, &cnt->passes, 0)) {
+        if (!tree_trace(sc, &tr, &state, &ph, tc, &cnt->passes)) {
             acc += tr.weight * vb_cload3(f->background) *
                    medium_absorb(sc, medium_material(sc, state), INFINITY);
             continue;
@@ -330,6 +331,7 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
         sp.scale = s.p[3];
         sp.ng = vload3(0, s.ng);
         sp.ns = vload3(0, s.ns);
+        sp.tri = -1; /* not recorded: its rays leave nothing out (ray_objects) */
         Crossing c;
         c.after = s.after;
         c.mat_before = s.mat_before;

@@ -110,11 +110,14 @@ typedef struct ObjectSet {
                * texture parts) of big: a feeler that meets the bounding sphere of one of
                * them walks the grid, the others test the ranges alone */
     uint big[VB_OBJECT_SET_MAX_BIG];
-    int sole; /* the host that all the set holds (ranges and big records) belongs to, where
-               * its own triangles bound a convex volume (VBCL_OBJECT_CONVEX or _HULL; its
-               * texture may reach out), or -1: a feeler that leaves it meets nothing more */
-    int walk; /* 1: the big records' triangles too, through the grid where the ray lies in
-               * their bounding spheres (object_set_span); 0: the ranges alone */
+    int sole;  /* the host that all the set holds (ranges and big records) belongs to, where
+                * its own triangles bound a convex volume (VBCL_OBJECT_CONVEX or _HULL; its
+                * texture may reach out), or -1: a feeler that leaves it meets nothing more */
+    int walk;  /* 1: the big records' triangles too, through the grid where the ray lies in
+                * their bounding spheres (object_set_span); 0: the ranges alone */
+    int shell; /* a host the ray starts inside (VBCL_OBJECT_INNER), whose own triangles the
+                * walk takes where the ray has left the host's inner sphere and not yet its
+                * own sphere (ray_objects), or -1 */
 } ObjectSet;
 
 /* Where the line from org along the unit dir lies in sphere b (centre, radius; radius < 0:
@@ -160,11 +163,27 @@ VB_INLINE int object_segment_meets(__global const VbObject *ob, float3 org, floa
     return object_stretch_meets(ob, org, dir, (float2)(0.0f, t));
 }
 
+/* Where the line from org along the unit dir leaves sphere b (centre, radius; radius < 0:
+ * none), drawn in by margins as sphere_chord's: -INFINITY where it misses it. */
+VB_INLINE float sphere_exit_inner(float4 b, float3 org, float3 dir, float reach)
+{
+    if (b.w < 0.0f) return -INFINITY;
+    float3 v = b.xyz - org;
+    float along = dot(v, dir);
+    float3 q = v - along * dir;
+    float h2 = b.w * b.w - dot(q, q);
+    if (h2 < 0.0f) return -INFINITY;
+    return along + sqrt(h2) - 1e-5f * (fabs(reach) + length(v) + b.w);
+}
+
 /* The stretch of the segment from org along the unit dir to distance t that holds every
  * point where it lies in the bounding sphere of one of the set's big records (margins as
- * object_stretch_meets); x > y where it meets none. All of a big record's triangles lie
- * in its sphere, and the cone test has shown that no triangle outside the set can meet
- * the segment: the grid need be walked only there. */
+ * object_stretch_meets), and, for its shell host, between where it leaves the host's inner
+ * sphere and where it leaves the sphere of the host's own triangles; x > y where it meets
+ * none. All of a big record's triangles lie in its sphere, a convex host's own triangles
+ * outside its inner sphere (from inside, the line meets them once, on its way out), and
+ * the cone test has shown that no triangle outside the set can meet the segment: the grid
+ * need be walked only there. */
 VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
                                  float t)
 {
@@ -172,6 +191,12 @@ VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3
     for (int k = 0; k < os->nbig; k++) {
         float2 c = object_chord(sc->objects + os->big[k], org, dir, t);
         span = (float2)(fmin(span.x, c.x), fmax(span.y, c.y));
+    }
+    if (os->shell >= 0) {
+        __global const VbObject *ob = sc->objects + os->shell;
+        float2 c = sphere_chord(vload4(0, ob->own), org, dir, t);
+        float in = sphere_exit_inner(vload4(0, ob->plane), org, dir, t);
+        span = (float2)(fmin(span.x, fmax(c.x, in)), fmax(span.y, c.y));
     }
     return (float2)(fmax(span.x, 0.0f), fmin(span.y, t));
 }
@@ -298,6 +323,19 @@ VB_INLINE int object_set_big(ObjectSet *os, uint rec)
     }
     os->big[os->nbig++] = rec;
     return 1;
+}
+
+/* The set of every triangle: scene_trace_closest_in walks the grid. */
+VB_INLINE ObjectSet object_set_all(void)
+{
+    ObjectSet os;
+    os.n = -1;
+    os.tris = 0u;
+    os.nbig = 0;
+    os.sole = -1;
+    os.walk = 0;
+    os.shell = -1;
+    return os;
 }
 
 /* The quad after the last of range k of a set. */

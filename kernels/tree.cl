@@ -25,6 +25,7 @@ typedef struct TreeRay {
     float3 org, dir;
     float3 weight; /* what its radiance counts for in the pixel */
     VbMedium medium;
+    int tri; /* the triangle it leaves from, or -1: not known (ray_objects) */
     int depth;
     uint key; /* from the branch's path, so pruning one branch leaves the others' jitter alone */
     int band; /* the wavelength band it carries, or -1: all of them (white) */
@@ -43,9 +44,9 @@ typedef struct TreeCount {
  * sample sum to at most min_weight (so pruning changes the pixel by at most min_weight
  * times the brightest radiance in the scene); beyond that budget only branches below
  * min_weight / 1000 are dropped. */
-VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 w, VbMedium m,
-                         int depth, uint key, __constant const VbFrame *f, TreeCount *cnt,
-                         int transmitted, int band)
+VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, int tri, float3 dir, float3 w,
+                         VbMedium m, int depth, uint key, __constant const VbFrame *f,
+                         TreeCount *cnt, int transmitted, int band)
 {
     float wm = vb_max3(w);
     if (wm <= 0.0f) return; /* no energy: nothing to trace or count */
@@ -63,6 +64,7 @@ VB_INLINE void tree_push(TreeRay *stack, int *n, float3 org, float3 dir, float3 
     t.dir = dir;
     t.weight = w;
     t.medium = m;
+    t.tri = tri;
     t.depth = depth;
     t.key = key;
     t.band = band;
@@ -90,9 +92,9 @@ VB_INLINE void tree_push_bands(const DevScene *sc, TreeRay *stack, int *n, const
         cnt->tir += (uint)s.tir;
         cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
         if (s.T > 0.0f)
-            tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
-                      wg * bw * (s.T * medium_band_transmit(sc, c->mat_after, b)), c->after, depth,
-                      vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
+            tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), sp->tri,
+                      s.transmitted, wg * bw * (s.T * medium_band_transmit(sc, c->mat_after, b)),
+                      c->after, depth, vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
     }
 }
 
@@ -143,16 +145,16 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
                                              medium_eta(sc, c->mat_after, b));
                 wr += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) * s.R;
             }
-            tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s0.reflected, wg * wr,
-                      before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
+            tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s0.reflected,
+                      wg * wr, before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
             uint tkey = vb_hash(2u * sp->key + 2u);
             if (!tree_record_split(rec, sp, dir, c, wg, depth, tkey))
                 tree_push_bands(sc, stack, n, sp, dir, c, wg, depth, tkey, cnt);
             return;
         }
         cnt->tir += (uint)s0.tir;
-        tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s0.reflected, wg * s0.R,
-                  before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
+        tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s0.reflected,
+                  wg * s0.R, before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
         return;
     }
     float eta1 = medium_eta(sc, c->mat_before, band), eta2 = medium_eta(sc, c->mat_after, band);
@@ -166,12 +168,22 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
     cnt->tir += (uint)s.tir;
     cnt->interfaces++;
     cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
-    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), s.reflected, wg * s.R, before,
-              depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, band);
+    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s.reflected, wg * s.R,
+              before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, band);
     if (s.T > 0.0f)
-        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), s.transmitted,
+        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), sp->tri, s.transmitted,
                   wg * (s.T * tin), c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1,
                   band);
+}
+
+/* The first interface along tree ray tr within the triangles it can meet (ray_objects;
+ * medium_trace follows it through pass-through crossings, updating *state). */
+VB_INLINE int tree_trace(const DevScene *sc, const TreeRay *tr, VbMedium *state, PathHit *ph,
+                         TraceCount *tc, uint *passes)
+{
+    ObjectSet os;
+    float reach = ray_objects(sc, tr->org, tr->dir, tr->tri, tr->medium.host, &os);
+    return medium_trace(sc, &os, tr->org, tr->dir, reach, state, ph, tc, passes, 0);
 }
 
 #endif

@@ -43,6 +43,10 @@
 #define VBCL_OBJECT_HULL                                                                           \
     16u /* its own triangles bound a convex volume (its texture aside): a feeler's stretch         \
          * inside it is the segment clipped by their planes */
+#define VBCL_OBJECT_INNER                                                                          \
+    32u /* a host of more than VBCL_OBJECT_SET_MAX_TRIS / 2 own triangles that bound a convex      \
+         * volume: VbObject.plane holds a sphere behind every plane of them (its inner sphere),    \
+         * so a ray inside it meets them only where it has left that sphere (ray_objects) */
 #define VBCL_OBJECT_SOLID                                                                          \
     8u /* a texture part that is convex, of an opaque material, strictly inside its convex         \
         * host and apart from the texture's other parts: VbObject.plane holds a sphere inside      \
@@ -159,7 +163,8 @@ typedef struct VbObject {
     unsigned int host;      /* a texture part's record: the object whose texture it is */
     float plane[4];         /* VBCL_OBJECT_PLANAR: unit normal n and offset k (n.x = k on
                              * the plane); w: k. Each vertex lies within plane_eps of it.
-                             * VBCL_OBJECT_SOLID (never planar): the core, centre and radius */
+                             * VBCL_OBJECT_SOLID (never planar): the core, centre and radius;
+                             * VBCL_OBJECT_INNER (a host): the inner sphere, the same */
     unsigned int first_tri; /* its own triangles: first_tri .. first_tri + ntris - 1 */
     unsigned int ntris;
     unsigned int first_tex; /* its texture's triangles */

@@ -661,6 +661,21 @@ static int core_inside(const Mesh *m, float core[4], uint32_t host, uint32_t hos
     return 1;
 }
 
+/* Gives host record g, whose own triangles first .. first + n - 1 of m bound a convex volume
+ * of more than VBCL_OBJECT_SET_MAX_TRIS / 2 triangles, its inner sphere (VBCL_OBJECT_INNER,
+ * in VbObject.plane): about the centre of their own sphere, behind every plane of them by
+ * margin (core_inside). Nothing where that centre is not so far inside. */
+static void host_inner(const Mesh *m, VbObject *g, uint32_t first, uint32_t n, double margin)
+{
+    float core[4];
+    memcpy(core, g->own, sizeof core);
+    if (n <= VBCL_OBJECT_SET_MAX_TRIS / 2 || (g->flags & VBCL_OBJECT_PLANAR) ||
+        !core_inside(m, core, first, n, margin))
+        return;
+    memcpy(g->plane, core, sizeof core);
+    g->flags |= VBCL_OBJECT_INNER;
+}
+
 /* Marks the solid parts (VBCL_OBJECT_SOLID) among the nparts records parts of object o's
  * texture (o's record g), with a core (part_core) in VbObject.plane: o a convex host whose
  * texture material T is opaque and no object's own material, the part closed, convex and
@@ -723,11 +738,14 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         g->first_tex = o->first_tex_tri;
         g->ntex = o->ntex_tris;
         int nruns = texture_parts(&s->mesh, o->first_tex_tri, o->ntex_tris, runs);
-        if (nruns <= 0) continue;
         double mag = 0.0;
         for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(g->lo[a]), fabs(g->hi[a])));
-        if (o->is_host && hull_convex(&s->mesh, o->first_tri, o->ntris, mag + g->bound[3]))
-            g->flags |= VBCL_OBJECT_HULL;
+        int big = o->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2;
+        int hull = o->is_host && (nruns > 0 || big) &&
+                   hull_convex(&s->mesh, o->first_tri, o->ntris, mag + g->bound[3]);
+        if (hull) host_inner(&s->mesh, g, o->first_tri, o->ntris, 1e-5 * (mag + g->bound[3]));
+        if (nruns <= 0) continue;
+        if (hull) g->flags |= VBCL_OBJECT_HULL;
         VbObject *grown = realloc(objs, sizeof *objs * (n + (size_t)nruns));
         if (!grown) goto fail;
         objs = grown;

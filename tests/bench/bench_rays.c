@@ -13,7 +13,8 @@
  *               light_shade_local / as many rtcIntersect1 from crossing to crossing as the
  *               renderer's walk (medium_shadow_transmittance) makes
  *   secondary   reflected and transmitted rays from primary hits on dielectrics (tree_spawn):
- *               scene_trace_closest / rtcIntersect1
+ *               as the renderer's ray trees trace them, among the triangles each can meet
+ *               (ray_objects, scene_trace_closest_in) / rtcIntersect1
  * Each repeat runs every kind on vbcl (OpenCL event time of the probe kernel) and then on
  * Embree (wall time of the tracing on --threads threads); the medians are compared. The two
  * sides must agree on hit/miss and the closest distance for 99.9% of the rays. */
@@ -555,9 +556,10 @@ static int vbcl_time(Bench *b, int k, double *ms)
         }
         return 0;
     }
-    int n = (int)kd->nrays, camera = k == KIND_PRIMARY; /* as the renderer traces them */
+    /* as the renderer traces them: probe_trace_closest's modes 1 (camera) and 2 (ray tree) */
+    int n = (int)kd->nrays, mode = k == KIND_PRIMARY ? 1 : 2;
     const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem), sizeof(int)};
-    const void *vals[] = {&kd->in, &n, &kd->out, &camera};
+    const void *vals[] = {&kd->in, &n, &kd->out, &mode};
     return probe_args(b, b->k_closest, 4, sz, vals) || probe_run(b, b->k_closest, kd->nrays, ms)
                ? -1
                : 0;
