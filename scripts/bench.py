@@ -554,7 +554,8 @@ def part_embree(a, out):
             "light_shade_local against rtcOccluded1); shadow_glass (the other opaque primary hits' "
             "feelers: light_shade_local against as many rtcIntersect1 from crossing to crossing as "
             "the renderer's walk makes); secondary (reflected and transmitted rays from primary "
-            "hits on dielectrics, closest hit). vbcl_any: the shadow feelers by scene_trace_any "
+            "hits on dielectrics, closest hit; vbcl as its ray trees trace them, among the objects "
+            "each can meet). vbcl_any: the shadow feelers by scene_trace_any "
             "alone. agreement: rays on which both sides agree on hit or miss and the distance "
             "(1e-4 relative).")
     return write_table(out, "embree", rows,
