@@ -66,21 +66,30 @@ VB_INLINE float grid_walk_exit(const GridWalk *w)
     return fmin(w->nx, fmin(w->ny, w->nz));
 }
 
+/* Where the line from org along the direction whose inverse is inv (+-inf for zero
+ * components) lies in the grid's box, which holds every triangle: (enter, leave), the ray
+ * parameters of its slab test. */
+VB_INLINE float2 grid_box_span(__constant const VbGrid *g, float3 org, float3 inv)
+{
+    float3 lo = vb_cload3(g->lo), hi = vb_cload3(g->hi);
+    float3 t0 = (lo - org) * inv, t1 = (hi - org) * inv;
+    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
+    /* NaN (0 * inf, a ray in a slab plane) must not narrow the interval */
+    return (float2)(fmax(isnan(tn.x) ? 0.0f : tn.x,
+                         fmax(isnan(tn.y) ? 0.0f : tn.y, isnan(tn.z) ? 0.0f : tn.z)),
+                    fmin(isnan(tf.x) ? INFINITY : tf.x,
+                         fmin(isnan(tf.y) ? INFINITY : tf.y, isnan(tf.z) ? INFINITY : tf.z)));
+}
+
 /* Clips the ray's stretch [tmin, tmax] (tmin >= 0) to the grid box and finds its first
  * cell. Returns 0 when the stretch misses the grid. */
 VB_INLINE int grid_walk_begin(__constant const VbGrid *g, float3 org, float3 dir, float tmin,
                               float tmax, GridWalk *w)
 {
-    float3 lo = vb_cload3(g->lo), hi = vb_cload3(g->hi);
+    float3 lo = vb_cload3(g->lo);
     float3 inv = (float3)(1.0f) / dir; /* +-inf for zero components */
-    float3 t0 = (lo - org) * inv, t1 = (hi - org) * inv;
-    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
-    /* NaN (0 * inf, a ray in a slab plane) must not narrow the interval */
-    float enter = fmax(tmin, fmax(isnan(tn.x) ? 0.0f : tn.x,
-                                  fmax(isnan(tn.y) ? 0.0f : tn.y, isnan(tn.z) ? 0.0f : tn.z)));
-    float leave =
-        fmin(tmax, fmin(isnan(tf.x) ? INFINITY : tf.x,
-                        fmin(isnan(tf.y) ? INFINITY : tf.y, isnan(tf.z) ? INFINITY : tf.z)));
+    float2 box = grid_box_span(g, org, inv);
+    float enter = fmax(tmin, box.x), leave = fmin(tmax, box.y);
     if (!(enter <= leave)) return 0;
     float3 cs = vb_cload3(g->cell), ics = vb_cload3(g->inv_cell);
     int3 n = (int3)(g->n[0], g->n[1], g->n[2]);

@@ -168,14 +168,18 @@ VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 d
  * to distance d, can meet the box [lo, hi]: the cone is cut into 4 pieces along the axis,
  * and piece i, between distances d i / 4 and d (i + 1) / 4, lies within d (i + 1) / 4 tan_t
  * of the axis, so it can meet the box only if that stretch of the axis meets the box widened
- * by this radius and the margin m (slab test). Conservative: true where unsure. */
+ * by this radius and the margin m (slab test). A cone of no width (a ray, a point light's
+ * feelers) is one piece: its four would be the same slab test on stretches that cover the
+ * one from end to end. Conservative: true where unsure. */
 VB_INLINE int light_cone_meets_box(float3 o, float3 axis, float d, float tan_t, float3 lo,
                                    float3 hi, float m)
 {
     float3 inv = 1.0f / axis;
     int3 flat = isless(fabs(axis), (float3)(1e-12f));
-    for (int i = 0; i < 4; i++) {
-        float t0 = d * 0.25f * (float)i, t1 = d * 0.25f * (float)(i + 1);
+    int pieces = tan_t > 0.0f ? 4 : 1;
+    float step = tan_t > 0.0f ? 0.25f : 1.0f;
+    for (int i = 0; i < pieces; i++) {
+        float t0 = d * step * (float)i, t1 = d * step * (float)(i + 1);
         float rad = t1 * tan_t + m;
         float3 a = (lo - rad - o) * inv, b = (hi + rad - o) * inv;
         float3 tn = fmin(a, b), tf = fmax(a, b);
@@ -303,69 +307,19 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
     os->sole = owners;
 }
 
-/* Whether a ray of cone k (a cone of half-angle 0: ray_objects; inv = 1 / k->axis) can meet
- * a triangle that record ob bounds: light_cone_meets for such a cone, the box tested once
- * along the whole stretch (the four pieces of light_cone_meets_box are one when the cone
- * has no width). */
-VB_INLINE int ray_meets(const LightCone *k, float3 inv, __global const VbObject *ob)
-{
-    float4 b = vload4(0, ob->bound);
-    if (b.w < 0.0f) return 0;
-    float3 v = b.xyz - k->o;
-    float along = dot(v, k->axis);
-    float3 q = v - along * k->axis;
-    float3 aq = fabs(q);
-    /* the margin of light_cone_meets, with |q| bounded by the sum of its components */
-    float m = b.w + 1e-5f * (k->d + fabs(along) + aq.x + aq.y + aq.z + b.w);
-    if (along < -m || along > k->d + m || dot(q, q) > m * m) return 0;
-    float mb = m - b.w;
-    float3 lo = vload3(0, ob->lo) - mb, hi = vload3(0, ob->hi) + mb;
-    int3 flat = isless(fabs(k->axis), (float3)(1e-12f));
-    float3 t0 = (lo - k->o) * inv, t1 = (hi - k->o) * inv;
-    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
-    int3 inside = isgreaterequal(k->o, lo) & islessequal(k->o, hi);
-    tn = select(tn, select((float3)(INFINITY), (float3)(-INFINITY), inside), flat);
-    tf = select(tf, select((float3)(-INFINITY), (float3)(INFINITY), inside), flat);
-    if (fmax(fmax(tn.x, tn.y), fmax(tn.z, -mb)) > fmin(fmin(tf.x, tf.y), fmin(tf.z, k->d + mb)))
-        return 0;
-    if (ob->flags & VBCL_OBJECT_PLANAR) {
-        float4 pl = vload4(0, ob->plane);
-        float e = ob->plane_eps + 1e-6f * k->reach;
-        float so = dot(pl.xyz, k->o) - pl.w, sl = dot(pl.xyz, k->c) - pl.w;
-        if ((so > e && sl > e) || (so < -e && sl < -e)) return 0;
-    }
-    return 1;
-}
-
-/* Adds the parts of record ob's texture that a ray of cone k meets (ray_meets) to the set:
+/* Adds the parts of record ob's texture that a ray of cone k meets (light_cone_meets) to the set:
  * a small one's triangles, a bigger one as big. 0 where the set overflows. */
-VB_INLINE int ray_parts(const DevScene *scn, const LightCone *k, float3 inv,
-                        __global const VbObject *ob, ObjectSet *os)
+VB_INLINE int ray_parts(const DevScene *scn, const LightCone *k, __global const VbObject *ob,
+                        ObjectSet *os)
 {
     for (uint e = ob->first_elem; e < ob->first_elem + ob->nelems; e++) {
         __global const VbObject *el = scn->objects + e;
-        if (!ray_meets(k, inv, el)) continue;
+        if (!light_cone_meets(k, el)) continue;
         if (el->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 ? !object_set_add(os, el->quad_tri, el->ntris)
                                                       : !object_set_big(os, e))
             return 0;
     }
     return 1;
-}
-
-/* Where the line from org along the unit direction whose inverse is inv lies in the grid's
- * box, which holds every triangle: (enter, leave); *m gets a margin for their rounding. */
-VB_INLINE float2 ray_grid_box(const DevScene *scn, float3 org, float3 inv, float *m)
-{
-    float3 lo = vb_cload3(scn->f->grid.lo), hi = vb_cload3(scn->f->grid.hi);
-    float3 t0 = (lo - org) * inv, t1 = (hi - org) * inv;
-    float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
-    /* NaN (0 * inf: the ray in a slab's plane) must not narrow the interval */
-    float enter =
-        fmax(isnan(tn.x) ? 0.0f : tn.x, fmax(isnan(tn.y) ? 0.0f : tn.y, isnan(tn.z) ? 0.0f : tn.z));
-    float leave = fmin(isnan(tf.x) ? INFINITY : tf.x,
-                       fmin(isnan(tf.y) ? INFINITY : tf.y, isnan(tf.z) ? INFINITY : tf.z));
-    *m = 1e-4f * (fabs(leave) + vb_max3(fabs(org)) + vb_max3(hi - lo));
-    return (float2)(enter, leave);
 }
 
 /* The object a ray from org along the unit axis leaves behind, starting on triangle tri
@@ -390,7 +344,7 @@ VB_INLINE int ray_start_object(const DevScene *scn, float3 org, float3 axis, int
 
 /* The triangles that a ray of a ray tree, from org along dir, leaving triangle tri (-1:
  * none) and inside host `host` (VbMedium.host, -1: none), can meet (VBCL_FRAME_CONE_TEST,
- * as for feelers): those of the objects whose bounds the ray meets (ray_meets) between org
+ * as for feelers): those of the objects whose bounds the ray meets (light_cone_meets) between org
  * and where it leaves the grid's box, which holds every triangle. A small object's
  * triangles (and its texture's, where that has no parts and fits) are tested alone; a
  * bigger one is big: the grid is walked where the ray lies in its bounding sphere
@@ -419,9 +373,9 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
     if (!(scn->f->flags & VBCL_FRAME_CONE_TEST)) return INFINITY;
     float len = length(dir);
     float3 axis = dir / len;
-    float3 inv = (float3)(1.0f) / axis;
-    float m;
-    float2 box = ray_grid_box(scn, org, inv, &m);
+    float2 box = grid_box_span(&scn->f->grid, org, (float3)(1.0f) / axis);
+    float m = 1e-4f * (fabs(box.y) + vb_max3(fabs(org)) +
+                       vb_max3(vb_cload3(scn->f->grid.hi) - vb_cload3(scn->f->grid.lo)));
     int front;
     int object = ray_start_object(scn, org, axis, tri, &front);
     /* inside a host, only a big convex one's own triangles are settled without the grid
@@ -459,7 +413,7 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
         uint flags = ob->flags;
         if ((int)i == host) { /* inside it: its own triangles as a shell */
             os->shell = (int)i;
-            if (ob->nelems > 0u ? !ray_parts(scn, &k, inv, ob, os)
+            if (ob->nelems > 0u ? !ray_parts(scn, &k, ob, os)
                                 : ob->ntex > 0u && (ob->quad_tex == VBCL_NO_QUADS ||
                                                     !object_set_add(os, ob->quad_tex, ob->ntex)))
                 return INFINITY;
@@ -469,9 +423,9 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
             (int)i == object && ((flags & VBCL_OBJECT_PLANAR) ||
                                  ((flags & (VBCL_OBJECT_CONVEX | VBCL_OBJECT_HULL)) && front));
         if (own && ob->ntex == 0u) continue;
-        if (!ray_meets(&k, inv, ob)) continue;
+        if (!light_cone_meets(&k, ob)) continue;
         if (own && ob->nelems > 0u) { /* its own triangles left behind: the parts */
-            if (!ray_parts(scn, &k, inv, ob, os)) return INFINITY;
+            if (!ray_parts(scn, &k, ob, os)) return INFINITY;
             continue;
         }
         int small = !own && ob->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 &&
