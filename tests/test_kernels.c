@@ -682,6 +682,36 @@ static unsigned *run_cone_probe(Fixture *fx, const char *kernel, int ncases, int
     return out;
 }
 
+/* The scene of the shadow cone test and of the ray trees' sets, the small sphere of material
+ * SPHERE ("m": opaque; "g": a glass host): a floor and a tilted wall (planar), a box, a prism
+ * and the sphere (convex), a vase (neither), a glass prism with a texture of bombed spheres,
+ * some reaching out of it, and a glass ball of 320 triangles whose bombed spheres reach out
+ * of it or lie wholly outside. */
+#define CONE_SCENE(SPHERE)                                                                         \
+    "{" CAM "\"materials\": {\"m\": {}, \"g\": {\"k_local\": 0.1, "                                \
+    "\"k_global\": 0.9, \"eta\": 1.5}, \"e\": {\"diffuse\": [1, 0, 0]}},"                          \
+    " \"objects\": ["                                                                              \
+    "{\"shape\": \"quad\", \"size\": [10, 10], \"material\": \"m\"},"                              \
+    "{\"shape\": \"quad\", \"size\": [6, 3], \"material\": \"m\","                                 \
+    " \"transform\": {\"rotate\": [70, 20, 0], \"translate\": [0, 2, -3]}},"                       \
+    "{\"shape\": \"box\", \"size\": [1, 2, 0.5], \"material\": \"m\","                             \
+    " \"transform\": {\"rotate\": [10, 30, 5], \"translate\": [-2, 1, 0]}},"                       \
+    "{\"shape\": \"prism\", \"material\": \"m\","                                                  \
+    " \"transform\": {\"translate\": [2, 0.5, 1]}},"                                               \
+    "{\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.6, \"centre\": [0, 2.5, 1],"              \
+    " \"material\": \"" SPHERE "\"},"                                                              \
+    "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","                           \
+    " \"profile\": [[0.5, 0], [0.2, 0.6], [0.6, 1.2], [0.3, 1.6]],"                                \
+    " \"transform\": {\"translate\": [0.5, 0, -1]}},"                                              \
+    "{\"shape\": \"prism\", \"depth\": 1.6, \"points\": [[-0.9, 0], [0.9, 0], [0, 1.5]],"          \
+    " \"material\": \"g\", \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, "         \
+    "0.05, 2]},"                                                                                   \
+    " \"texture\": {\"generate\": \"bomb --shape sphere --count 6 --size 20:30 --seed 3\","        \
+    " \"material\": \"e\"}},"                                                                      \
+    "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.7, \"centre\": [2.5, 1.2, -2.5],"         \
+    " \"material\": \"g\", \"texture\": {\"generate\": \"bomb --shape sphere --count 12 "          \
+    "--size 14:24 --seed 8 --level 1\", \"material\": \"e\"}}]}"
+
 /* Whether p lies behind the plane of every own triangle of object o (inside it, where o is
  * convex). */
 static int inside_own_planes(const Mesh *m, const SceneObject *o, vec3 p)
@@ -709,32 +739,7 @@ static int inside_own_planes(const Mesh *m, const SceneObject *o, vec3 p)
 static void test_ray_objects_brute(void)
 {
     Fixture fx;
-    if (fixture_open(
-            &fx,
-            "{" CAM "\"materials\": {\"m\": {}, \"g\": {\"k_local\": 0.1, "
-            "\"k_global\": 0.9, \"eta\": 1.5}, \"e\": {\"diffuse\": [1, 0, 0]}},"
-            " \"objects\": ["
-            "{\"shape\": \"quad\", \"size\": [10, 10], \"material\": \"m\"},"
-            "{\"shape\": \"quad\", \"size\": [6, 3], \"material\": \"m\","
-            " \"transform\": {\"rotate\": [70, 20, 0], \"translate\": [0, 2, -3]}},"
-            "{\"shape\": \"box\", \"size\": [1, 2, 0.5], \"material\": \"m\","
-            " \"transform\": {\"rotate\": [10, 30, 5], \"translate\": [-2, 1, 0]}},"
-            "{\"shape\": \"prism\", \"material\": \"m\","
-            " \"transform\": {\"translate\": [2, 0.5, 1]}},"
-            "{\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.6, \"centre\": [0, 2.5, 1],"
-            " \"material\": \"g\"},"
-            "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","
-            " \"profile\": [[0.5, 0], [0.2, 0.6], [0.6, 1.2], [0.3, 1.6]],"
-            " \"transform\": {\"translate\": [0.5, 0, -1]}},"
-            "{\"shape\": \"prism\", \"depth\": 1.6, \"points\": [[-0.9, 0], [0.9, 0], [0, 1.5]],"
-            " \"material\": \"g\", \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, "
-            "0.05, 2]},"
-            " \"texture\": {\"generate\": \"bomb --shape sphere --count 6 --size 20:30 --seed 3\","
-            " \"material\": \"e\"}},"
-            "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.7, \"centre\": [2.5, 1.2, -2.5],"
-            " \"material\": \"g\", \"texture\": {\"generate\": \"bomb --shape sphere --count 12 "
-            "--size 14:24 --seed 8 --level 1\", \"material\": \"e\"}}]}"))
-        return;
+    if (fixture_open(&fx, CONE_SCENE("g"))) return;
     enum { CASES = 8192, RAYS = 128 };
     const Mesh *m = &fx.s.mesh;
     float *cases = calloc((size_t)CASES * 16, sizeof(float));
@@ -829,32 +834,7 @@ static void test_ray_objects_brute(void)
 static void test_light_cone_brute(void)
 {
     Fixture fx;
-    if (fixture_open(
-            &fx,
-            "{" CAM "\"materials\": {\"m\": {}, \"g\": {\"k_local\": 0.1, "
-            "\"k_global\": 0.9, \"eta\": 1.5}, \"e\": {\"diffuse\": [1, 0, 0]}},"
-            " \"objects\": ["
-            "{\"shape\": \"quad\", \"size\": [10, 10], \"material\": \"m\"},"
-            "{\"shape\": \"quad\", \"size\": [6, 3], \"material\": \"m\","
-            " \"transform\": {\"rotate\": [70, 20, 0], \"translate\": [0, 2, -3]}},"
-            "{\"shape\": \"box\", \"size\": [1, 2, 0.5], \"material\": \"m\","
-            " \"transform\": {\"rotate\": [10, 30, 5], \"translate\": [-2, 1, 0]}},"
-            "{\"shape\": \"prism\", \"material\": \"m\","
-            " \"transform\": {\"translate\": [2, 0.5, 1]}},"
-            "{\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.6, \"centre\": [0, 2.5, 1],"
-            " \"material\": \"m\"},"
-            "{\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\","
-            " \"profile\": [[0.5, 0], [0.2, 0.6], [0.6, 1.2], [0.3, 1.6]],"
-            " \"transform\": {\"translate\": [0.5, 0, -1]}},"
-            "{\"shape\": \"prism\", \"depth\": 1.6, \"points\": [[-0.9, 0], [0.9, 0], [0, 1.5]],"
-            " \"material\": \"g\", \"transform\": {\"rotate\": [0, 25, 0], \"translate\": [-0.5, "
-            "0.05, 2]},"
-            " \"texture\": {\"generate\": \"bomb --shape sphere --count 6 --size 20:30 --seed 3\","
-            " \"material\": \"e\"}},"
-            "{\"shape\": \"sphere\", \"level\": 2, \"radius\": 0.7, \"centre\": [2.5, 1.2, -2.5],"
-            " \"material\": \"g\", \"texture\": {\"generate\": \"bomb --shape sphere --count 12 "
-            "--size 14:24 --seed 8 --level 1\", \"material\": \"e\"}}]}"))
-        return;
+    if (fixture_open(&fx, CONE_SCENE("m"))) return;
     enum { CASES = 16384, RAYS = 128 };
     const Mesh *m = &fx.s.mesh;
     float *cases;
