@@ -415,8 +415,10 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
             os->shell = (int)i;
             if (ob->nelems > 0u ? !ray_parts(scn, &k, ob, os)
                                 : ob->ntex > 0u && (ob->quad_tex == VBCL_NO_QUADS ||
-                                                    !object_set_add(os, ob->quad_tex, ob->ntex)))
+                                                    !object_set_add(os, ob->quad_tex, ob->ntex))) {
+                os->n = -1; /* a texture too big for the set and without parts: the grid */
                 return INFINITY;
+            }
             continue;
         }
         int own =
