@@ -3,6 +3,7 @@
 
 #include <stdarg.h>
 #include <string.h>
+#include <time.h>
 
 int th_checks_failed;
 static int passed, failed, skipped, skipping;
@@ -31,16 +32,20 @@ void th_run(const char *name, void (*fn)(void))
     th_checks_failed = 0;
     skipping = 0;
     fprintf(stderr, "  %s ...\n", name);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     fn();
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double secs = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     if (th_checks_failed) {
         failed++;
-        printf("FAIL %s (%d failed checks)\n", name, th_checks_failed);
+        printf("FAIL %s (%d failed checks, %.1f s)\n", name, th_checks_failed, secs);
     } else if (skipping) {
         skipped++;
-        printf("skip %s\n", name);
+        printf("skip %s (%.1f s)\n", name, secs);
     } else {
         passed++;
-        printf("ok   %s\n", name);
+        printf("ok   %s (%.1f s)\n", name, secs);
     }
     fflush(stdout);
 }

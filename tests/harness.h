@@ -17,7 +17,8 @@ void th_fail(const char *file, int line, const char *expr, const char *fmt, ...)
         if (!(cond)) th_fail(__FILE__, __LINE__, #cond, __VA_ARGS__);                              \
     } while (0)
 
-/* Runs fn as one test unless a name filter excludes it; prints "ok NAME" or "FAIL NAME". */
+/* Runs fn as one test unless a name filter excludes it; prints "ok NAME (T s)" or
+ * "FAIL NAME (N failed checks, T s)", T its wall time. */
 void th_run(const char *name, void (*fn)(void));
 #define RUN_TEST(fn) th_run(#fn, fn)
 
