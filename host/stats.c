@@ -39,7 +39,11 @@ static void print_setup(FILE *f, const StatsFrame *fr)
     fprintf(f, "device      %s (%s)\n", fr->dev->name, fr->dev->version);
     fprintf(f, "features    %s\n", feat);
     fprintf(f, "program     %.1f ms (%s), options: %s\n", st->build_ms,
-            st->build_cached ? "warm: cached binary" : "cold: built from source", st->options);
+            st->build_cached == CLU_BINARY               ? "warm: cached binary"
+            : st->build_cached == CLU_BUILT_DRIVER_CACHE ? "built from source through the driver's "
+                                                           "kernel cache"
+                                                         : "cold: built from source",
+            st->options);
     fprintf(f,
             "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max "
             "%u, empty %.1f%%, per non-empty cell %.2f, refined %d times\n",
@@ -246,7 +250,12 @@ static void json_setup(cJSON *root, const StatsFrame *fr, int *ok)
         if (strcmp(w, "none")) push(a, cJSON_CreateString(w), ok);
     o = obj(root, "program", ok);
     num(o, "build_ms", st->build_ms, ok);
-    flag(o, "cached", st->build_cached, ok);
+    flag(o, "cached", st->build_cached == CLU_BINARY, ok);
+    str(o, "from",
+        st->build_cached == CLU_BINARY               ? "binary"
+        : st->build_cached == CLU_BUILT_DRIVER_CACHE ? "source_driver_cache"
+                                                     : "source",
+        ok);
     str(o, "options", st->options, ok);
 }
 

@@ -9,7 +9,7 @@
               on scenes from about 100 to 184,000 triangles;
   3. error    run time against error (RMSE and PSNR against a converged reference) for
               anti-aliasing thresholds (scripts/bench_aa.py) and for band counts;
-  4. build    kernel build time, cold (empty binary cache) and warm, per feature set;
+  4. build    kernel build time, cold (empty caches) and warm, per feature set;
   5. embree   Mrays/s per ray kind against Embree 3 on the same triangles and rays
               (build/vbcl-bench-rays, tests/bench/bench_rays.c; vbcl alone without Embree);
   6. drivers  Mrays/s by ray kind on every OpenCL device vbcl sees (PoCL; Intel's CPU
@@ -108,11 +108,11 @@ STAT_FIELDS = {
 
 
 def run_stats(vbcl, scene, opts, env=None):
-    """Runs vbcl with --stats-json; returns the numbers of STAT_FIELDS, "cold" (the program
-    was built from source) and "grid" ("XxYxZ")."""
+    """Runs vbcl with --stats-json; returns the numbers of STAT_FIELDS, "from" (how the
+    program came: binary, source, source_driver_cache) and "grid" ("XxYxZ")."""
     doc = read_stats_json(vbcl, scene, opts, env)
     st = {k: float(doc[g][f]) for k, (g, f) in STAT_FIELDS.items()}
-    st["cold"] = not doc["program"]["cached"]
+    st["from"] = doc["program"]["from"]
     st["grid"] = "x".join(str(n) for n in doc["grid"]["resolution"])
     return st
 
@@ -437,7 +437,8 @@ def part_build(a, out):
             print(f"build: {rows[-1]}", flush=True)
     note = ("An 8x8 render with empty caches (cold: clBuildProgram from source; PoCL's own "
             "kernel cache, POCL_CACHE_DIR, emptied too), then again with the caches the first "
-            "run filled (warm: clCreateProgramWithBinary). "
+            "run filled (warm: clCreateProgramWithBinary from vbcl's cache, or on PoCL, where "
+            "vbcl stores no binary, clBuildProgram served by PoCL's kernel cache). "
             "first_render_ms: the render's wall time, which on PoCL includes compiling each "
             "kernel's work-group function at its first launch; process_s: the whole command "
             "(texture generation comes from its own cache in both).")

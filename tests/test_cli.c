@@ -151,7 +151,8 @@ static void test_cli_cache_pruned(void)
     if (f) fclose(f);
     const char *scene = tu_write_file("prune.json", GOOD_SCENE);
     snprintf(cmd, sizeof cmd,
-             "VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=3 timeout 300 %s %s -q --stats -o %s/p.png "
+             "VBCL_CACHE_BINARIES=1 VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=3 timeout 300 %s %s -q "
+             "--stats -o %s/p.png "
              "--width 8 --height 8",
              dir, tu_vbcl, scene, tu_tmpdir());
     CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "cold: built from source"),
@@ -184,12 +185,63 @@ static void test_cli_cache_pruned(void)
     snprintf(path, sizeof path, "%s/notes.txt", dir);
     CHECK(file_exists(path), "a file that is not a binary stays");
     snprintf(cmd, sizeof cmd,
-             "VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=x timeout 300 %s %s -q --stats -o %s/p.png "
+             "VBCL_CACHE_BINARIES=1 VBCL_CACHE_DIR=%s VBCL_CACHE_MAX_MB=x timeout 300 %s %s -q "
+             "--stats -o %s/p.png "
              "--width 8 --height 8",
              dir, tu_vbcl, scene, tu_tmpdir());
     CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "warm: cached binary") &&
               strstr(out, "VBCL_CACHE_MAX_MB=\"x\" is not a positive whole number"),
           "a warm run names the bad limit: %s", out);
+}
+
+/* Counts the files named *.bin in dir. */
+static int bin_files(const char *dir)
+{
+    int n = 0;
+    DIR *d = opendir(dir);
+    for (struct dirent *e; d && (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        n += len > 4 && !strcmp(e->d_name + len - 4, ".bin");
+    }
+    if (d) closedir(d);
+    return n;
+}
+
+/* On a driver that keeps its own kernel cache (PoCL), vbcl stores no binary by default and
+ * says so ("from": "source_driver_cache"); VBCL_CACHE_BINARIES=1 stores one all the same,
+ * and a value other than 0 or 1 is named. Elsewhere the default stores the binary. */
+static void test_cli_cache_binaries(void)
+{
+    VbDevice *dev = tu_device();
+    if (!dev) {
+        th_skip("no OpenCL device");
+        return;
+    }
+    int pocl = strstr(dev->name, "Portable Computing Language") != NULL;
+    char dir[512], cmd[4096], out[8192], json[600];
+    const char *scene = tu_write_file("binaries.json", GOOD_SCENE);
+    snprintf(json, sizeof json, "%s/binaries-stats.json", tu_tmpdir());
+    const char *envs[3] = {"", "VBCL_CACHE_BINARIES=1", "VBCL_CACHE_BINARIES=yes"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(dir, sizeof dir, "%s/binaries-cache-%d", tu_tmpdir(), k);
+        mkdir(dir, 0755);
+        snprintf(cmd, sizeof cmd,
+                 "%s VBCL_CACHE_DIR=%s timeout 300 %s %s -q -o %s/b.png --width 8 --height 8 "
+                 "--stats-json %s",
+                 envs[k], dir, tu_vbcl, scene, tu_tmpdir(), json);
+        int rc = tu_run(cmd, out, sizeof out);
+        cJSON *doc = read_json(json);
+        const cJSON *prog = cJSON_GetObjectItemCaseSensitive(doc, "program");
+        const char *got = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(prog, "from"));
+        int stored = bin_files(dir), want = k == 1 || !pocl;
+        const char *from = want ? "source" : "source_driver_cache";
+        CHECK(rc == 0 && stored == want && got && !strcmp(got, from),
+              "%s: %d binaries stored, want %d; from %s, want %s: rc %d, %s",
+              envs[k][0] ? envs[k] : "default", stored, want, got ? got : "(none)", from, rc, out);
+        cJSON_Delete(doc);
+    }
+    CHECK(strstr(out, "VBCL_CACHE_BINARIES=\"yes\" is not 0 or 1"), "a bad value is named: %s",
+          out);
 }
 
 static void test_cli_list_devices(void)
@@ -986,6 +1038,7 @@ void suite_cli(void)
     RUN_TEST(test_cli_help_and_usage);
     RUN_TEST(test_cli_image_plugin);
     RUN_TEST(test_cli_cache_pruned);
+    RUN_TEST(test_cli_cache_binaries);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);
     RUN_TEST(test_cli_bad_input_classes);

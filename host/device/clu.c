@@ -411,16 +411,46 @@ static void print_build_log(VbDevice *d, cl_program prog, const char *options)
     }
 }
 
+/* Whether d's driver keeps compiled kernels of its own between runs: PoCL does, in
+ * POCL_CACHE_DIR, unless POCL_KERNEL_CACHE is 0. */
+static int driver_caches_kernels(const VbDevice *d)
+{
+    char name[256] = "";
+    clGetPlatformInfo(d->platform, CL_PLATFORM_NAME, sizeof name, name, NULL);
+    const char *off = getenv("POCL_KERNEL_CACHE");
+    return strstr(name, "Portable Computing Language") && !(off && !strcmp(off, "0"));
+}
+
+/* Whether vbcl keeps d's program binaries itself: VBCL_CACHE_BINARIES 1 always, 0 never;
+ * by default only where the driver keeps no kernels of its own. On PoCL, asking for a
+ * program's binary compiles every kernel of the program once more, for the binary, while
+ * a build from source through PoCL's kernel cache is as quick as loading a binary
+ * (docs/architecture.md, "Kernel features"). */
+static int binaries_wanted(const VbDevice *d)
+{
+    const char *env = getenv("VBCL_CACHE_BINARIES");
+    if (env && (!strcmp(env, "0") || !strcmp(env, "1"))) return env[0] == '1';
+    if (env && *env) {
+        static _Thread_local int named;
+        if (!named++)
+            fprintf(stderr, "vbcl: VBCL_CACHE_BINARIES=\"%s\" is not 0 or 1; keeping the default\n",
+                    env);
+    }
+    return !driver_caches_kernels(d);
+}
+
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
                              int *cached)
 {
     double t0 = clu_now_ms();
     cl_int rc;
     cl_program prog = NULL;
-    *cached = 0;
+    *cached = CLU_BUILT;
     char dir[4096], path[4200] = "";
     uint64_t cache_max = 0; /* read on every run, so that a bad value is always named */
-    if (cache_dir(NULL, dir, sizeof dir)) {
+    int binaries = binaries_wanted(d);
+    if (!binaries) *cached = CLU_BUILT_DRIVER_CACHE;
+    if (binaries && cache_dir(NULL, dir, sizeof dir)) {
         cache_max = cache_max_bytes();
         uint64_t h = CACHE_HASH_SEED;
         h = cache_hash(h, source);
@@ -439,7 +469,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
             if (prog && rc == CL_SUCCESS && status == CL_SUCCESS &&
                 clBuildProgram(prog, 1, &d->device, options, NULL, NULL) == CL_SUCCESS) {
                 cache_touch(path); /* recently used: pruned last */
-                *cached = 1;
+                *cached = CLU_BINARY;
                 *ms = clu_now_ms() - t0;
                 return prog;
             }

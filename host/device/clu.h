@@ -90,8 +90,17 @@ int clu_devices_open(const char *spec, VbDevice *devs, int max, int *ndev, char 
                      size_t errlen);
 void clu_devices_close(VbDevice *devs, int n);
 
+/* How clu_program_build got its program. */
+enum {
+    CLU_BUILT = 0,              /* built from source */
+    CLU_BINARY = 1,             /* loaded from vbcl's binary cache */
+    CLU_BUILT_DRIVER_CACHE = 2, /* built from source by a driver that keeps compiled
+                                 * kernels itself (PoCL): cold or warm, the time tells */
+};
+
 /* Builds source with options for d. A binary cache keyed by source, options and device
- * is used unless VBCL_CACHE_DIR is "off"; *cached says whether it was a cache hit and
+ * is used unless VBCL_CACHE_DIR is "off", or the driver keeps its own kernel cache and
+ * VBCL_CACHE_BINARIES is not 1; *cached says how the program came (CLU_BUILT ...) and
  * *ms the time taken. On a failed build the log and the options are printed to stderr.
  * Returns the program, or NULL (clu_error() says why). */
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,

@@ -23,7 +23,7 @@ typedef struct RenderStats {
     unsigned features;
     char options[512];
     double build_ms;
-    int build_cached;
+    int build_cached; /* how the program came: CLU_BUILT, CLU_BINARY, CLU_BUILT_DRIVER_CACHE */
     double grid_ms, upload_ms;
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
     double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
