@@ -423,9 +423,9 @@ static int driver_caches_kernels(const VbDevice *d)
 
 /* Whether vbcl keeps d's program binaries itself: VBCL_CACHE_BINARIES 1 always, 0 never;
  * by default only where the driver keeps no kernels of its own. On PoCL, asking for a
- * program's binary compiles every kernel of the program once more, for the binary, while
- * a build from source through PoCL's kernel cache is as quick as loading a binary
- * (docs/architecture.md, "Kernel features"). */
+ * program's binary compiles every kernel of the program once more, for the binary, which
+ * costs a cold run far more than a build from source through PoCL's kernel cache costs a
+ * warm one over loading the binary (docs/architecture.md, "Kernel features"). */
 static int binaries_wanted(const VbDevice *d)
 {
     const char *env = getenv("VBCL_CACHE_BINARIES");
