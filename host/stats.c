@@ -26,6 +26,22 @@ static double per(unsigned long long a, unsigned long long b)
 /* ---- the --stats text ---- */
 
 /* scene, device, features, program, grid */
+/* How the program came (RenderStats.build_cached: CLU_BUILT, CLU_BINARY,
+ * CLU_BUILT_DRIVER_CACHE), as --stats says it and as --stats-json's program.from. */
+static const struct BuildSource {
+    const char *text, *json;
+} build_sources[] = {
+    [CLU_BUILT] = {"cold: built from source", "source"},
+    [CLU_BINARY] = {"warm: cached binary", "binary"},
+    [CLU_BUILT_DRIVER_CACHE] = {"built from source through the driver's kernel cache",
+                                "source_driver_cache"},
+};
+
+static const struct BuildSource *build_source(int how)
+{
+    return &build_sources[how == CLU_BINARY || how == CLU_BUILT_DRIVER_CACHE ? how : CLU_BUILT];
+}
+
 static void print_setup(FILE *f, const StatsFrame *fr)
 {
     const Scene *s = fr->scene;
@@ -39,11 +55,7 @@ static void print_setup(FILE *f, const StatsFrame *fr)
     fprintf(f, "device      %s (%s)\n", fr->dev->name, fr->dev->version);
     fprintf(f, "features    %s\n", feat);
     fprintf(f, "program     %.1f ms (%s), options: %s\n", st->build_ms,
-            st->build_cached == CLU_BINARY               ? "warm: cached binary"
-            : st->build_cached == CLU_BUILT_DRIVER_CACHE ? "built from source through the driver's "
-                                                           "kernel cache"
-                                                         : "cold: built from source",
-            st->options);
+            build_source(st->build_cached)->text, st->options);
     fprintf(f,
             "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max "
             "%u, empty %.1f%%, per non-empty cell %.2f, refined %d times\n",
@@ -251,11 +263,7 @@ static void json_setup(cJSON *root, const StatsFrame *fr, int *ok)
     o = obj(root, "program", ok);
     num(o, "build_ms", st->build_ms, ok);
     flag(o, "cached", st->build_cached == CLU_BINARY, ok);
-    str(o, "from",
-        st->build_cached == CLU_BINARY               ? "binary"
-        : st->build_cached == CLU_BUILT_DRIVER_CACHE ? "source_driver_cache"
-                                                     : "source",
-        ok);
+    str(o, "from", build_source(st->build_cached)->json, ok);
     str(o, "options", st->options, ok);
 }
 

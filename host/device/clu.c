@@ -428,15 +428,8 @@ static int driver_caches_kernels(const VbDevice *d)
  * warm one over loading the binary (docs/architecture.md, "Kernel features"). */
 static int binaries_wanted(const VbDevice *d)
 {
-    const char *env = getenv("VBCL_CACHE_BINARIES");
-    if (env && (!strcmp(env, "0") || !strcmp(env, "1"))) return env[0] == '1';
-    if (env && *env) {
-        static _Thread_local int named;
-        if (!named++)
-            fprintf(stderr, "vbcl: VBCL_CACHE_BINARIES=\"%s\" is not 0 or 1; keeping the default\n",
-                    env);
-    }
-    return !driver_caches_kernels(d);
+    int set = cache_binaries_setting();
+    return set >= 0 ? set : !driver_caches_kernels(d);
 }
 
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,

@@ -76,6 +76,26 @@ uint64_t cache_max_bytes(void)
     return cache_max;
 }
 
+static pthread_once_t cache_binaries_once = PTHREAD_ONCE_INIT;
+static int cache_binaries = -1;
+
+static void cache_binaries_read(void)
+{
+    const char *env = getenv("VBCL_CACHE_BINARIES");
+    if (!env || !*env) return;
+    if (!strcmp(env, "0") || !strcmp(env, "1"))
+        cache_binaries = env[0] == '1';
+    else
+        fprintf(stderr, "vbcl: VBCL_CACHE_BINARIES=\"%s\" is not 0 or 1; keeping the default\n",
+                env);
+}
+
+int cache_binaries_setting(void)
+{
+    pthread_once(&cache_binaries_once, cache_binaries_read);
+    return cache_binaries;
+}
+
 void cache_touch(const char *path)
 {
     utime(path, NULL); /* a cache file not marked is only pruned sooner */

@@ -17,6 +17,10 @@ const char *cache_dir(const char *sub, char *buf, size_t n);
 #define CACHE_MAX_MB_DEFAULT 256
 uint64_t cache_max_bytes(void);
 
+/* $VBCL_CACHE_BINARIES: 1 (store program binaries on every driver), 0 (on none), or -1
+ * when unset or another value, which is named with a warning, once per run. */
+int cache_binaries_setting(void);
+
 /* Marks path as just used (its modification time now), so that cache_prune keeps it
  * longer than the files not used since. */
 void cache_touch(const char *path);
