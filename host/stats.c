@@ -157,8 +157,8 @@ void stats_print(FILE *f, const StatsFrame *fr)
         f,
         "rays        primary %llu, refinement %llu, shadow %llu (%u per light per point%s%s; %llu "
         "skipped: light behind the surface; %llu clear: not traced, their cone meets no "
-        "object; %llu blocked: not traced, they pass through an opaque texture part's core; "
-        "%llu unneeded: no BRDF response), total %llu\n",
+        "object; %llu blocked: not traced, they pass through the core of an opaque part or "
+        "object; %llu unneeded: no BRDF response), total %llu\n",
         st->rays_primary, st->rays_refine, st->rays_shadow, strata * strata,
         (st->features & VBCL_FEATURE_TRANSPARENCY) && s->shadow_by_weight
             ? ", fewer at ray-tree points weighing 1/4 or less"

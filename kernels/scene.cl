@@ -202,9 +202,9 @@ VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3
 }
 
 /* Whether the segment from org along the unit dir to distance t passes through the core
- * of solid part ob (VBCL_OBJECT_SOLID) from outside the part's bounds: then it enters the
- * part before t (the core lies inside it, the origin outside). The core's radius has the
- * host's margins taken off already. */
+ * of solid object or part ob (VBCL_OBJECT_SOLID) from outside its bounds: then it enters it
+ * before t (the core lies inside it, the origin outside). The core's radius has the
+ * margins taken off already. */
 VB_INLINE int object_segment_through_core(__global const VbObject *ob, float3 org, float3 dir,
                                           float t)
 {
@@ -250,10 +250,10 @@ VB_INLINE float2 object_hull_stretch(const DevScene *sc, __global const VbObject
 
 /* What a feeler (org, dir, t) of set os needs: OBJECT_SET_ALONE, its set's triangles alone;
  * OBJECT_SET_GRID, the grid (it meets the bounds of one of the set's big objects or parts);
- * OBJECT_SET_BLOCKED, nothing: it passes through the core of a solid big part
- * (VBCL_OBJECT_SOLID) and is stopped there, whatever it crosses before (with transparency,
- * where the feeler starts outside every texture element: tex_free). start_host: the host
- * the feeler starts in (VbMedium.host). A big host that the feeler starts outside needs it
+ * OBJECT_SET_BLOCKED, nothing: it passes through the core of a solid big object or part
+ * (VBCL_OBJECT_SOLID) and is stopped there, whatever it crosses before (for a part, with
+ * transparency, where the feeler starts outside every texture element: tex_free). start_host: the
+ * host the feeler starts in (VbMedium.host). A big host that the feeler starts outside needs it
  * only where the feeler meets the sphere of the host's own triangles (VbObject.own): one
  * that never enters the host crosses none of its own triangles, and its texture's
  * surfaces outside the host change no material (medium_cross), so they stop nothing. */
@@ -271,7 +271,12 @@ VB_INLINE int object_set_feeler(const DevScene *sc, const ObjectSet *os, float3 
             if ((ob->flags & VBCL_OBJECT_HOST) && start_host != (int)os->big[k] &&
                 !sphere_stretch_meets(vload4(0, ob->own), org, dir, (float2)(0.0f, t)))
                 continue;
-            return OBJECT_SET_GRID;
+            /* an opaque object stops the feeler wherever it crosses its surface, in any
+             * medium: a later record's core may still do so where this one's does not */
+            if ((ob->flags & VBCL_OBJECT_SOLID) && object_segment_through_core(ob, org, dir, t))
+                return OBJECT_SET_BLOCKED;
+            need = OBJECT_SET_GRID;
+            continue;
         }
 #ifdef VBCL_HAS_TRANSPARENCY
         if (tex_free && (ob->flags & VBCL_OBJECT_SOLID) &&

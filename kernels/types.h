@@ -49,9 +49,10 @@
          * so a ray inside it meets them only where it has left that sphere (ray_objects) */
 #define VBCL_OBJECT_SOLID                                                                          \
     8u /* a texture part that is convex, of an opaque material, strictly inside its convex         \
-        * host and apart from the texture's other parts: VbObject.plane holds a sphere inside      \
-        * it (its core), and a feeler from outside its bounds that passes through the core is      \
-        * stopped by it, whatever it meets on the way */
+        * host and apart from the texture's other parts, or an opaque object (not a host) of       \
+        * more than VBCL_OBJECT_SET_MAX_TRIS / 2 triangles that close a convex surface:            \
+        * VbObject.plane holds a sphere inside it (its core), and a feeler from outside its        \
+        * bounds that passes through the core is stopped by it, whatever it meets on the way */
 
 /* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices

@@ -709,6 +709,31 @@ static void parts_solid(const Scene *s, const SceneObject *o, const VbObject *g,
     }
 }
 
+/* For opaque object o (not a host: a feeler that crosses any of its triangles is stopped,
+ * medium_cross) of more than the cone test's sets take one by one (VBCL_OBJECT_SET_MAX_TRIS /
+ * 2), not planar, whose record g's bounds object_bounds gave for size `size`: where its
+ * triangles bound a convex volume beyond object_convex's budget (hull_convex),
+ * VBCL_OBJECT_CONVEX, so that a feeler leaving the front of one of them skips it
+ * (light_cone_objects); where they are convex and close a surface, VBCL_OBJECT_SOLID with a
+ * core (part_core) in g->plane: a feeler from outside its bounding sphere that reaches a point
+ * of the core has crossed that surface, so nothing gets through and it need not be traced
+ * (object_set_feeler). */
+static void object_opaque_convex(const Mesh *m, const SceneObject *o, VbObject *g, double size)
+{
+    float core[4];
+    if (o->is_host || o->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 || (g->flags & VBCL_OBJECT_PLANAR))
+        return;
+    if (!(g->flags & VBCL_OBJECT_CONVEX)) {
+        if (!hull_convex(m, o->first_tri, o->ntris, size)) return;
+        g->flags |= VBCL_OBJECT_CONVEX;
+    }
+    if (!part_closed(m, o->first_tri, o->ntris) ||
+        !part_core(m, o->first_tri, o->ntris, 1e-5 * size, core))
+        return;
+    g->flags |= VBCL_OBJECT_SOLID;
+    memcpy(g->plane, core, sizeof core);
+}
+
 /* The objects' records for the kernels: the scene's objects, then the parts of their
  * textures (texture_parts); *count is how many records in all. NULL: out of memory. */
 static VbObject *objects_make(const Scene *s, size_t *count)
@@ -744,6 +769,7 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         int hull = o->is_host && (nruns > 0 || big) &&
                    hull_convex(&s->mesh, o->first_tri, o->ntris, mag + g->bound[3]);
         if (hull) host_inner(&s->mesh, g, o->first_tri, o->ntris, 1e-5 * (mag + g->bound[3]));
+        object_opaque_convex(&s->mesh, o, g, mag + g->bound[3]);
         if (nruns <= 0) continue;
         if (hull) g->flags |= VBCL_OBJECT_HULL;
         VbObject *grown = realloc(objs, sizeof *objs * (n + (size_t)nruns));
