@@ -712,7 +712,7 @@ static void parts_solid(const Scene *s, const SceneObject *o, const VbObject *g,
 /* For opaque object o (not a host: a feeler that crosses any of its triangles is stopped,
  * medium_cross) of more than the cone test's sets take one by one (VBCL_OBJECT_SET_MAX_TRIS /
  * 2), not planar, whose record g's bounds object_bounds gave for size `size`: where its
- * triangles bound a convex volume beyond object_convex's budget (hull_convex),
+ * triangles bound a convex volume beyond object_convex's budget (as hull_convex tests it),
  * VBCL_OBJECT_CONVEX, so that a feeler leaving the front of one of them skips it
  * (light_cone_objects); where they are convex and close a surface, VBCL_OBJECT_SOLID with a
  * core (part_core) in g->plane: a feeler from outside its bounding sphere that reaches a point
@@ -724,12 +724,16 @@ static void object_opaque_convex(const Mesh *m, const SceneObject *o, VbObject *
     if (o->is_host || o->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 || (g->flags & VBCL_OBJECT_PLANAR))
         return;
     if (!(g->flags & VBCL_OBJECT_CONVEX)) {
-        if (!hull_convex(m, o->first_tri, o->ntris, size)) return;
+        /* beyond object_convex's budget (hull_convex): the edge test, which also finds the
+         * surface closed */
+        if (3 * (uint64_t)o->ntris * o->ntris <= (1u << 24) ||
+            !mesh_part_convex(m, o->first_tri, o->ntris, 1e-9 * size))
+            return;
         g->flags |= VBCL_OBJECT_CONVEX;
-    }
-    if (!part_closed(m, o->first_tri, o->ntris) ||
-        !part_core(m, o->first_tri, o->ntris, 1e-5 * size, core))
+    } else if (!part_closed(m, o->first_tri, o->ntris)) {
         return;
+    }
+    if (!part_core(m, o->first_tri, o->ntris, 1e-5 * size, core)) return;
     g->flags |= VBCL_OBJECT_SOLID;
     memcpy(g->plane, core, sizeof core);
 }
