@@ -476,16 +476,26 @@ static int object_convex(const Mesh *m, uint32_t first, uint32_t n, uint32_t tex
     return convex;
 }
 
+/* object_convex's budget for an object's triangles: 2^24 vertex tests (2364 triangles
+ * alone). */
+#define OBJECT_CONVEX_BUDGET (1u << 24)
+
+/* Whether n triangles alone are beyond OBJECT_CONVEX_BUDGET, so that hull_convex tests them
+ * edge by edge. */
+static int convex_by_edges(uint32_t n)
+{
+    return 3 * (uint64_t)n * (uint64_t)n > OBJECT_CONVEX_BUDGET;
+}
+
 /* Whether a host's own triangles first .. first + n - 1 of m bound a convex volume
  * (VBCL_OBJECT_HULL), for an object of size `size`: every vertex behind every plane within
- * 1e-6 of it (object_convex) where that takes at most 2^24 tests (2364 triangles); beyond,
+ * 1e-6 of it (object_convex) within OBJECT_CONVEX_BUDGET; beyond (convex_by_edges),
  * strictly convex at every edge of one closed surface of genus 0 (mesh_part_convex, tol
  * 1e-9 of the size: a tessellated sphere of 81,920 triangles is convex by 4e-5 of it). */
 static int hull_convex(const Mesh *m, uint32_t first, uint32_t n, double size)
 {
-    const uint64_t budget = 1u << 24;
-    if (3 * (uint64_t)n * (uint64_t)n <= budget)
-        return object_convex(m, first, n, 0, 0, 1e-6 * size, budget);
+    if (!convex_by_edges(n))
+        return object_convex(m, first, n, 0, 0, 1e-6 * size, OBJECT_CONVEX_BUDGET);
     return mesh_part_convex(m, first, n, 1e-9 * size);
 }
 
@@ -712,7 +722,7 @@ static void parts_solid(const Scene *s, const SceneObject *o, const VbObject *g,
 /* For opaque object o (not a host: a feeler that crosses any of its triangles is stopped,
  * medium_cross) of more than the cone test's sets take one by one (VBCL_OBJECT_SET_MAX_TRIS /
  * 2), not planar, whose record g's bounds object_bounds gave for size `size`: where its
- * triangles bound a convex volume beyond object_convex's budget (as hull_convex tests it),
+ * triangles bound a convex volume beyond object_convex's budget (convex_by_edges),
  * VBCL_OBJECT_CONVEX, so that a feeler leaving the front of one of them skips it
  * (light_cone_objects); where they are convex and close a surface, VBCL_OBJECT_SOLID with a
  * core (part_core) in g->plane: a feeler from outside its bounding sphere that reaches a point
@@ -724,11 +734,8 @@ static void object_opaque_convex(const Mesh *m, const SceneObject *o, VbObject *
     if (o->is_host || o->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 || (g->flags & VBCL_OBJECT_PLANAR))
         return;
     if (!(g->flags & VBCL_OBJECT_CONVEX)) {
-        /* beyond object_convex's budget (hull_convex): the edge test, which also finds the
-         * surface closed */
-        if (3 * (uint64_t)o->ntris * o->ntris <= (1u << 24) ||
-            !mesh_part_convex(m, o->first_tri, o->ntris, 1e-9 * size))
-            return;
+        /* beyond object_convex's budget: the edge test, which also finds the surface closed */
+        if (!convex_by_edges(o->ntris) || !hull_convex(m, o->first_tri, o->ntris, size)) return;
         g->flags |= VBCL_OBJECT_CONVEX;
     } else if (!part_closed(m, o->first_tri, o->ntris)) {
         return;
@@ -753,8 +760,8 @@ static VbObject *objects_make(const Scene *s, size_t *count)
         g->tex_material = o->tex_slot >= 0 ? (unsigned)o->tex_material : (unsigned)o->material;
         g->tex_slot = o->tex_slot;
         g->flags = o->is_host ? VBCL_OBJECT_HOST : 0u;
-        object_bounds(&s->mesh, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris, 1u << 24,
-                      g);
+        object_bounds(&s->mesh, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris,
+                      OBJECT_CONVEX_BUDGET, g);
         memcpy(g->own, g->bound, sizeof g->own);
         if (o->ntex_tris > 0) { /* the sphere of its own triangles: the texture may reach out */
             VbObject own;
