@@ -25,7 +25,6 @@ static double per(unsigned long long a, unsigned long long b)
 
 /* ---- the --stats text ---- */
 
-/* scene, device, features, program, grid */
 /* How the program came (RenderStats.build_cached: CLU_BUILT, CLU_BINARY,
  * CLU_BUILT_DRIVER_CACHE), as --stats says it and as --stats-json's program.from. */
 static const struct BuildSource {
@@ -42,6 +41,7 @@ static const struct BuildSource *build_source(int how)
     return &build_sources[how == CLU_BINARY || how == CLU_BUILT_DRIVER_CACHE ? how : CLU_BUILT];
 }
 
+/* scene, device, features, program, grid */
 static void print_setup(FILE *f, const StatsFrame *fr)
 {
     const Scene *s = fr->scene;
