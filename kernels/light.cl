@@ -230,6 +230,13 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
     return 1;
 }
 
+/* The bit of VbObject.ahead that a ray or feeler leaving host ob through the front of its own
+ * triangle tri tests: a part without it lies wholly behind that triangle's plane. */
+VB_INLINE uint part_ahead_bit(__global const VbObject *ob, int tri)
+{
+    return ob->ntris <= 32u ? 1u << ((uint)tri - ob->first_tri) : 0xffffffffu;
+}
+
 /* The triangles that feelers from ls->origin toward the light sphere (radius r, 0 for a
  * point light) may meet (VBCL_FRAME_CONE_TEST; the host sets it for scenes of at most
  * VBCL_CONE_TEST_MAX_OBJECTS objects): none, so that no feeler need be traced; a few
@@ -246,7 +253,9 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
  * point's own object cannot stop a feeler when it is planar (a feeler is traced only toward the
  * side of the surface it leaves from), nor when it is convex and the feeler leaves from the front
  * of its triangle: all of the object lies behind that triangle's plane; the same holds for the
- * convex part of a texture the point lies on. Margins (1e-5 of the distances, the host's
+ * convex part of a texture the point lies on, for a host's own triangles where they bound a
+ * convex volume (VBCL_OBJECT_HULL), and for the parts of its texture that lie behind that
+ * plane (VbObject.ahead, part_ahead_bit). Margins (1e-5 of the distances, the host's
  * planarity margin) keep float rounding on the safe side: a triangle left out is one no
  * feeler's walk would meet, and the image is the same as with every feeler walked through
  * the grid. */
@@ -287,7 +296,11 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             if (!object_set_big(os, i)) return;
             continue;
         }
-        if (!object_set_add(os, ob->quad_tri, ob->ntris)) return;
+        /* leaving the point's own host outward: its own triangles lie behind the plane of
+         * sp's where they bound a convex volume, as do the parts without its ahead bit */
+        uint ahead = (int)i == sp->object && sp->front ? part_ahead_bit(ob, sp->tri) : 0u;
+        if (!(ahead && (flags & VBCL_OBJECT_HULL)) && !object_set_add(os, ob->quad_tri, ob->ntris))
+            return;
         if (ob->nelems == 0u) {
             if (!object_set_add(os, ob->quad_tex, ob->ntex)) return;
             continue;
@@ -296,7 +309,7 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
             __global const VbObject *el = scn->objects + ob->first_elem + e;
             if (tri - el->first_tri < el->ntris && (el->flags & VBCL_OBJECT_CONVEX) && sp->front)
                 continue;
-            if (!light_cone_meets(&k, el)) continue;
+            if ((ahead && !(el->ahead & ahead)) || !light_cone_meets(&k, el)) continue;
             if (el->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2) { /* each feeler tests its bounds */
                 if (!object_set_big(os, ob->first_elem + e)) return;
             } else if (!object_set_add(os, el->quad_tri, el->ntris)) {
@@ -308,13 +321,15 @@ VB_INLINE void light_cone_objects(const DevScene *scn, const ShadePoint *sp, con
 }
 
 /* Adds the parts of record ob's texture that a ray of cone k meets (light_cone_meets) to the set:
- * a small one's triangles, a bigger one as big. 0 where the set overflows. */
+ * a small one's triangles, a bigger one as big; where ahead is not 0 (part_ahead_bit: the ray
+ * leaves ob through the front of one of its own triangles), only parts that may reach ahead of
+ * that triangle's plane. 0 where the set overflows. */
 VB_INLINE int ray_parts(const DevScene *scn, const LightCone *k, __global const VbObject *ob,
-                        ObjectSet *os)
+                        uint ahead, ObjectSet *os)
 {
     for (uint e = ob->first_elem; e < ob->first_elem + ob->nelems; e++) {
         __global const VbObject *el = scn->objects + e;
-        if (!light_cone_meets(k, el)) continue;
+        if ((ahead && !(el->ahead & ahead)) || !light_cone_meets(k, el)) continue;
         if (el->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 ? !object_set_add(os, el->quad_tri, el->ntris)
                                                       : !object_set_big(os, e))
             return 0;
@@ -354,8 +369,9 @@ VB_INLINE int ray_start_object(const DevScene *scn, float3 org, float3 axis, int
  * host, so no part it meets may be left out. A ray that moves away from its triangle's
  * plane, on the side it starts on, cannot meet a planar start object again, nor a convex
  * one it leaves to the outer side: their own triangles are left out (all of them lie
- * behind that plane). A ray inside a big convex host (VBCL_OBJECT_INNER), having entered it
- * through one of its own triangles, meets them again only on its way out, beyond the
+ * behind that plane), and so are the parts of a host's texture that lie behind it
+ * (VbObject.ahead, part_ahead_bit). A ray inside a big convex host (VBCL_OBJECT_INNER), having
+ * entered it through one of its own triangles, meets them again only on its way out, beyond the
  * host's inner sphere: the host is the set's shell, walked only there; and where every way
  * out of the host is an interface (its material and its texture's both differ from the
  * air's) the search ends where the ray leaves the host, since medium_trace stops at the
@@ -413,7 +429,7 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
         uint flags = ob->flags;
         if ((int)i == host) { /* inside it: its own triangles as a shell */
             os->shell = (int)i;
-            if (ob->nelems > 0u ? !ray_parts(scn, &k, ob, os)
+            if (ob->nelems > 0u ? !ray_parts(scn, &k, ob, 0u, os)
                                 : ob->ntex > 0u && (ob->quad_tex == VBCL_NO_QUADS ||
                                                     !object_set_add(os, ob->quad_tex, ob->ntex))) {
                 os->n = -1; /* a texture too big for the set and without parts: the grid */
@@ -427,7 +443,7 @@ VB_INLINE float ray_objects(const DevScene *scn, float3 org, float3 dir, int tri
         if (own && ob->ntex == 0u) continue;
         if (!light_cone_meets(&k, ob)) continue;
         if (own && ob->nelems > 0u) { /* its own triangles left behind: the parts */
-            if (!ray_parts(scn, &k, ob, os)) return INFINITY;
+            if (!ray_parts(scn, &k, ob, front ? part_ahead_bit(ob, tri) : 0u, os)) return INFINITY;
             continue;
         }
         int small = !own && ob->ntris <= VBCL_OBJECT_SET_MAX_TRIS / 2 &&

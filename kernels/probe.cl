@@ -604,8 +604,11 @@ __kernel void probe_ray_objects(SCENE_KERNEL_ARGS __global const float *cases, i
         flags |= planar_or_convex && dot(nt, w) > 0.0f && dot(nt, o - a) > 0.0f ? 8u : 0u;
         flags |= os.nbig > 0 ? 16u : 0u;
         flags |= ha ? 32u : 0u;
+        if ((flags & 8u) && ob->nelems > 0u) /* leaving its host: a part left behind */
+            for (uint e = ob->first_elem; e < ob->first_elem + ob->nelems; e++)
+                flags |= objects[e].ahead & part_ahead_bit(ob, tri) ? 0u : 64u;
     }
-    out[i] = min(wrong, 0xffffu) | flags << 16 | min(first, 1023u) << 22;
+    out[i] = min(wrong, 0xffffu) | flags << 16 | min(first, 511u) << 23;
 }
 #endif
 

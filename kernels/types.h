@@ -186,6 +186,14 @@ typedef struct VbObject {
                             * VBCL_OBJECT_SET_MAX_TRIS / 2 (a set never holds them) */
     unsigned int quad_tex; /* the same for its texture's triangles, where it has no parts
                             * (nelems 0) and they and its own fit in a set together */
+    unsigned int ahead;    /* a texture part's record: bit j set where the part may reach ahead
+                            * of the plane of its host's own triangle host.first_tri + j (host
+                            * of at most 32 own triangles; of more, all bits set, or none where
+                            * it lies within the host's inner sphere); clear only where it lies
+                            * behind that plane by a margin, so that a ray or feeler leaving the
+                            * host through the front of that triangle cannot meet it
+                            * (part_ahead_bit). All set for a host that is not VBCL_OBJECT_HULL */
+    unsigned int pad[3];
 } VbObject;
 
 /* The shadow cone test's sets of triangles (kernels/scene.cl, ObjectSet): at most this many
@@ -365,7 +373,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
-    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) X(VBCL_OFFSETOF(VbObject, ahead)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -404,7 +412,8 @@ VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
 VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
-VBCL_STATIC_ASSERT(sizeof(VbObject) == 128, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 144, object_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ahead) == 128, object_ahead);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, own) == 104, object_own);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tri) == 120, object_quad_tri);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tex) == 124, object_quad_tex);

@@ -686,6 +686,44 @@ static void host_inner(const Mesh *m, VbObject *g, uint32_t first, uint32_t n, d
     g->flags |= VBCL_OBJECT_INNER;
 }
 
+/* The parts' VbObject.ahead for host record g, whose own triangles first .. first + n - 1 of m
+ * bound a convex volume (VBCL_OBJECT_HULL): for a host of at most 32 of them, bit j clear
+ * where every vertex of the part lies behind the plane of triangle first + j by at least
+ * margin (the part lies wholly behind it: a ray leaving the host through the front of that
+ * triangle, ahead of its plane from then on, cannot meet the part); for a larger host, no
+ * bit set where the part's bounding sphere lies within the host's inner sphere
+ * (VBCL_OBJECT_INNER) by margin, behind every plane of it, and every bit otherwise. */
+static void parts_ahead(const Mesh *m, const VbObject *g, uint32_t first, uint32_t n,
+                        VbObject *parts, int nparts, double margin)
+{
+    for (int e = 0; e < nparts; e++) {
+        VbObject *el = &parts[e];
+        el->ahead = ~0u;
+        if (n > 32) {
+            double d2 = 0.0;
+            for (int a = 0; a < 3; a++)
+                d2 += ((double)el->bound[a] - g->plane[a]) * ((double)el->bound[a] - g->plane[a]);
+            if ((g->flags & VBCL_OBJECT_INNER) && sqrt(d2) + el->bound[3] + margin <= g->plane[3])
+                el->ahead = 0u;
+            continue;
+        }
+        for (uint32_t j = 0; j < n; j++) {
+            double x[3];
+            vec3 p0 = mesh_tri_normal_d(m, first + j, x);
+            double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            int behind = len > 0.0;
+            for (uint32_t t = el->first_tri; t < el->first_tri + el->ntris && behind; t++)
+                for (int k = 0; k < 3 && behind; k++) {
+                    vec3 v = m->verts[m->tris[3 * t + k]];
+                    double h =
+                        (x[0] * (v.x - p0.x) + x[1] * (v.y - p0.y) + x[2] * (v.z - p0.z)) / len;
+                    behind = h <= -margin;
+                }
+            if (behind) el->ahead &= ~(1u << j);
+        }
+    }
+}
+
 /* Marks the solid parts (VBCL_OBJECT_SOLID) among the nparts records parts of object o's
  * texture (o's record g), with a core (part_core) in VbObject.plane: o a convex host whose
  * texture material T is opaque and no object's own material, the part closed, convex and
@@ -795,8 +833,12 @@ static VbObject *objects_make(const Scene *s, size_t *count)
             el->first_tri = runs[e][0];
             el->ntris = runs[e][1];
             el->host = (unsigned)i;
+            el->ahead = ~0u;
         }
         parts_solid(s, o, &objs[i], objs + objs[i].first_elem, nruns);
+        if (hull)
+            parts_ahead(&s->mesh, &objs[i], o->first_tri, o->ntris, objs + objs[i].first_elem,
+                        nruns, 1e-5 * (mag + objs[i].bound[3]));
     }
     free(runs);
     *count = n;
