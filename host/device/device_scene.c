@@ -686,40 +686,42 @@ static void host_inner(const Mesh *m, VbObject *g, uint32_t first, uint32_t n, d
     g->flags |= VBCL_OBJECT_INNER;
 }
 
-/* The parts' VbObject.ahead for host record g, whose own triangles first .. first + n - 1 of m
- * bound a convex volume (VBCL_OBJECT_HULL): for a host of at most 32 of them, bit j clear
- * where every vertex of the part lies behind the plane of triangle first + j by at least
- * margin (the part lies wholly behind it: a ray leaving the host through the front of that
- * triangle, ahead of its plane from then on, cannot meet the part); for a larger host, no
- * bit set where the part's bounding sphere lies within the host's inner sphere
- * (VBCL_OBJECT_INNER) by margin, behind every plane of it, and every bit otherwise. */
+/* Clears bits of the parts' VbObject.ahead (all set by objects_make) for host record g, whose
+ * own triangles first .. first + n - 1 of m bound a convex volume (VBCL_OBJECT_HULL): for a
+ * host of at most 32 of them (part_ahead_bit), bit j where every vertex of the part lies
+ * behind the plane of triangle first + j by at least margin (the part lies wholly behind it:
+ * a ray leaving the host through the front of that triangle, ahead of its plane from then on,
+ * cannot meet the part); for a larger host, every bit where the part's bounding sphere lies
+ * within the host's inner sphere (VBCL_OBJECT_INNER) by margin, behind every plane of it. */
 static void parts_ahead(const Mesh *m, const VbObject *g, uint32_t first, uint32_t n,
                         VbObject *parts, int nparts, double margin)
 {
-    for (int e = 0; e < nparts; e++) {
-        VbObject *el = &parts[e];
-        el->ahead = ~0u;
-        if (n > 32) {
+    if (n > 32) {
+        for (int e = 0; e < nparts && (g->flags & VBCL_OBJECT_INNER); e++) {
             double d2 = 0.0;
             for (int a = 0; a < 3; a++)
-                d2 += ((double)el->bound[a] - g->plane[a]) * ((double)el->bound[a] - g->plane[a]);
-            if ((g->flags & VBCL_OBJECT_INNER) && sqrt(d2) + el->bound[3] + margin <= g->plane[3])
-                el->ahead = 0u;
-            continue;
+                d2 += ((double)parts[e].bound[a] - g->plane[a]) *
+                      ((double)parts[e].bound[a] - g->plane[a]);
+            if (sqrt(d2) + parts[e].bound[3] + margin <= g->plane[3]) parts[e].ahead = 0u;
         }
-        for (uint32_t j = 0; j < n; j++) {
-            double x[3];
-            vec3 p0 = mesh_tri_normal_d(m, first + j, x);
-            double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-            int behind = len > 0.0;
-            for (uint32_t t = el->first_tri; t < el->first_tri + el->ntris && behind; t++)
+        return;
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        double x[3];
+        vec3 p0 = mesh_tri_normal_d(m, first + j, x);
+        double len = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        if (!(len > 0.0)) continue;
+        for (int e = 0; e < nparts; e++) {
+            int behind = 1;
+            for (uint32_t t = parts[e].first_tri; t < parts[e].first_tri + parts[e].ntris && behind;
+                 t++)
                 for (int k = 0; k < 3 && behind; k++) {
                     vec3 v = m->verts[m->tris[3 * t + k]];
                     double h =
                         (x[0] * (v.x - p0.x) + x[1] * (v.y - p0.y) + x[2] * (v.z - p0.z)) / len;
                     behind = h <= -margin;
                 }
-            if (behind) el->ahead &= ~(1u << j);
+            if (behind) parts[e].ahead &= ~(1u << j);
         }
     }
 }
