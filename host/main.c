@@ -76,6 +76,10 @@ static const char usage_text[] =
     "                           contrast |a-b|/max(a+b,F) with an adjacent one exceeds\n"
     "                           THRESHOLD (0..1; 0 off; F: --aa-floor)\n"
     "      --aa-max-level L     deepest refinement, 2^L x 2^L subpixels per pixel (1..4)\n"
+    "      --aa-min-level L     split every pixel down to 2^L x 2^L subpixels before the\n"
+    "                           contrast test (0..max level; default 0): a floor under\n"
+    "                           adaptivity for features pass 0's one ray misses; equal to\n"
+    "                           --aa-max-level, uniform 4^L samples through the quadtree\n"
     "      --aa-floor F         contrast of dark pairs: a+b counts as at least F (0..2;\n"
     "                           default 1: below it the test is |a-b| > THRESHOLD; 0:\n"
     "                           the thesis's plain ratio)\n"
@@ -120,7 +124,7 @@ typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_reconstruct, *aa_pairs, *aa_map,
         *aa_samples_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
-    int width, height, shadow_samples, depth, aa_max_level, ssaa, bands, seed;
+    int width, height, shadow_samples, depth, aa_max_level, aa_min_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
     int list_devices, stats, quiet, no_cone_test, no_camera_tiles, all_feelers, penumbra_feelers;
@@ -190,6 +194,7 @@ static const OptionSpec option_specs[] = {
     {"--min-weight", NULL, OPT_DOUBLE, offsetof(Options, min_weight), 0, 1},
     {"--aa", NULL, OPT_DOUBLE, offsetof(Options, aa), 0, 1},
     {"--aa-max-level", NULL, OPT_INT, offsetof(Options, aa_max_level), 1, VBCL_AA_MAX_LEVEL},
+    {"--aa-min-level", NULL, OPT_INT, offsetof(Options, aa_min_level), 0, VBCL_AA_MAX_LEVEL},
     {"--aa-floor", NULL, OPT_DOUBLE, offsetof(Options, aa_floor), 0, 2},
     {"--aa-level-gain", NULL, OPT_DOUBLE, offsetof(Options, aa_level_gain), 1, 4},
     {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
@@ -306,7 +311,7 @@ static int parse_args(int argc, char **argv, Options *o)
     o->width = o->height = o->shadow_samples = o->depth = -1;
     o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
     o->aa_level_gain = -1;
-    o->aa_max_level = o->ssaa = o->bands = o->seed = -1;
+    o->aa_max_level = o->aa_min_level = o->ssaa = o->bands = o->seed = -1;
     o->frame_first = o->frame_last = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -448,6 +453,7 @@ static int apply_options(const Options *o, Scene *s)
     if (o->no_sample_shares) s->sample_shares = 0;
     if (o->penumbra_feelers > 0) s->penumbra_feelers = o->penumbra_feelers;
     if (o->aa_max_level > 0) s->aa_max_level = o->aa_max_level;
+    if (o->aa_min_level >= 0) s->aa_min_level = o->aa_min_level;
     if (o->bands >= 0) {
         s->band_layout = o->bands ? DISP_LAYOUT_UNIFORM : DISP_LAYOUT_THESIS;
         s->bands = o->bands ? o->bands : DISP_THESIS_BANDS;
@@ -457,6 +463,13 @@ static int apply_options(const Options *o, Scene *s)
         if (o->aa > 0) return usage_error("%s", "--aa and --ssaa exclude each other");
         s->aa_threshold = 0.0f; /* --ssaa overrides the scene's render.aa */
     }
+    if (s->aa_min_level > s->aa_max_level)
+        return usage_error("the minimum refinement level (%d, --aa-min-level or "
+                           "render.aa_min_level) exceeds the deepest (%d, --aa-max-level or "
+                           "render.aa_max_level)",
+                           s->aa_min_level, s->aa_max_level);
+    if (o->aa_min_level > 0 && !(s->aa_threshold > 0.0f))
+        return usage_error("%s", "--aa-min-level needs adaptive anti-aliasing (--aa or render.aa)");
     if ((o->aa_map || o->aa_samples_map) && !(s->aa_threshold > 0.0f))
         return usage_error("%s needs adaptive anti-aliasing (--aa or render.aa)",
                            o->aa_map ? "--aa-map" : "--aa-samples-map");

@@ -120,9 +120,9 @@ static void print_samples(FILE *f, const Scene *s, const RenderStats *st)
     if (!(s->aa_threshold > 0.0f)) return;
     fprintf(f,
             "anti-alias  adaptive quadtree, threshold %g (x %g per level), floor %g, max level %d, "
-            "reconstruct %s, pairs %s, %d rounds; pixels refined to level",
+            "min level %d, reconstruct %s, pairs %s, %d rounds; pixels refined to level",
             (double)s->aa_threshold, (double)s->aa_level_gain, (double)s->aa_floor, s->aa_max_level,
-            aa_reconstruct_name(s), aa_pairs_name(s), st->aa_rounds);
+            s->aa_min_level, aa_reconstruct_name(s), aa_pairs_name(s), st->aa_rounds);
     for (int l = 1; l <= s->aa_max_level; l++)
         fprintf(f, " %d (%dx%d): %llu%s", l, 1 << l, 1 << l, st->aa_refined[l],
                 l < s->aa_max_level ? "," : "\n");
@@ -338,6 +338,7 @@ static void json_samples(cJSON *root, const Scene *s, const RenderStats *st, int
     fnum(o, "floor", adaptive ? s->aa_floor : 0.0f, ok);
     fnum(o, "level_gain", adaptive ? s->aa_level_gain : 0.0f, ok);
     num(o, "max_level", adaptive ? s->aa_max_level : 0, ok);
+    num(o, "min_level", adaptive ? s->aa_min_level : 0, ok);
     str(o, "reconstruct", adaptive ? aa_reconstruct_name(s) : "none", ok);
     str(o, "pairs", adaptive ? aa_pairs_name(s) : "none", ok);
     num(o, "rounds", st->aa_rounds, ok);

@@ -784,6 +784,11 @@ static void test_cli_bad_input_classes(void)
     expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
                " \"render\": {\"aa_reconstruct\": \"mean\"}}",
                NULL, "render.aa_reconstruct"); /* not a reconstruction */
+    expect_bad("{\"camera\": {\"eye\": [0,0,1], \"look_at\": [0,0,0]},"
+               " \"render\": {\"aa\": 0.1, \"aa_max_level\": 2, \"aa_min_level\": 3}}",
+               NULL, "render.aa_min_level"); /* below the deepest level */
+    expect_bad(GOOD_SCENE, "--aa 0.1 --aa-max-level 1 --aa-min-level 2", "--aa-min-level");
+    expect_bad(GOOD_SCENE, "--aa-min-level 1", "needs adaptive anti-aliasing");
     expect_bad(GOOD_SCENE, "--aa-reconstruct box", "--aa-reconstruct box");
     expect_bad(GOOD_SCENE, "--penumbra-feelers 6", "--penumbra-feelers 6");
     expect_bad(GOOD_SCENE, "--grid 0", "--grid");        /* bad option */

@@ -54,7 +54,7 @@ static int aa_capacity(const VbDevice *d, size_t need, size_t elem, const char *
     if (*want >= need) return 0;
     snprintf(err, errlen,
              "anti-aliasing needs %.0f MiB for its %s, more than one allocation on %s "
-             "allows (%.0f MiB); raise the threshold or lower --aa-max-level",
+             "allows (%.0f MiB); raise the threshold, or lower --aa-max-level or --aa-min-level",
              (double)(need * elem) / 1048576.0, what, d->name, (double)d->max_alloc / 1048576.0);
     return 2;
 }
@@ -94,6 +94,7 @@ static int aa_reserve_trees(AaState *aa, Renderer *r, size_t need, size_t keep, 
     size_t elem = sizeof(float) * 4 * AA_TREE_NODES, want;
     if (need <= aa->tree_cap) return 0;
     if (aa_capacity(d, need, elem, "trees", &want, err, errlen)) return 2;
+    if (want > aa->npix && need <= aa->npix) want = aa->npix; /* a slot per pixel at most */
     cl_mem levels = clu_buffer(d, NULL, want * VBCL_AA_CELLS, CL_MEM_READ_WRITE);
     cl_mem values = levels ? clu_buffer(d, NULL, want * elem, CL_MEM_READ_WRITE) : NULL;
     if (!values) goto fail;
@@ -220,6 +221,22 @@ static void aa_progress(AaProgress *pg, int round, int level, unsigned long long
     pg->shown = 1;
 }
 
+/* Splits the k nodes listed in aa->marks from entry `first` on (at most a third of the ray
+ * buffers): their three new samples each are traced and stored into the trees. Returns 0
+ * or -1. */
+static int aa_split_batch(AaState *aa, Renderer *r, VbAaPass *pass, unsigned first, unsigned k,
+                          RenderStats *st)
+{
+    pass->first = first;
+    pass->entries = k;
+    if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
+    const cl_mem args[10] = {aa->pass,        aa->marks,  r->radiance, aa->film,   aa->slots,
+                             aa->slot_pixels, aa->levels, aa->values,  aa->counts, aa->split};
+    if (aa_launch(r, r->k_aa_split_store, 0, args, 10, k, &st->aa_reconstruct_ms)) return -1;
+    st->samples += 3ull * k;
+    return 0;
+}
+
 /* Splits the `marked` nodes listed in aa->marks: batches of whole nodes (three rays each)
  * as wide as the ray buffers, each traced and stored into the trees. Returns 0 or -1. */
 static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, RenderStats *st,
@@ -228,16 +245,49 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
     unsigned per = (unsigned)r->ray_capacity / 3;
     for (unsigned done = 0; done < marked; done += per) {
         unsigned k = marked - done < per ? marked - done : per;
-        pass->first = done;
-        pass->entries = k;
-        if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
-        const cl_mem args[10] = {aa->pass,        aa->marks,  r->radiance, aa->film,   aa->slots,
-                                 aa->slot_pixels, aa->levels, aa->values,  aa->counts, aa->split};
-        if (aa_launch(r, r->k_aa_split_store, 0, args, 10, k, &st->aa_reconstruct_ms)) return -1;
-        st->samples += 3ull * k;
+        if (aa_split_batch(aa, r, pass, done, k, st)) return -1;
         aa_progress(pg, round, level, st->samples, npix, done + k, marked);
     }
     return 0;
+}
+
+/* Round `level` of the rounds below s->aa_min_level, which split every node of every pixel
+ * at that level without a contrast test: the host lists the nodes a batch at a time, in
+ * pixel order (into aa->marks, which must hold a batch), clears this round's half of aa->split
+ * (aa_contrast_mark's work in a tested round) and splits them as aa_split does. Returns 0
+ * or -1. */
+static int aa_split_all(AaState *aa, Renderer *r, VbAaPass *pass, int level, RenderStats *st,
+                        AaProgress *pg, unsigned long long npix)
+{
+    VbDevice *d = r->dev;
+    unsigned per = (unsigned)r->ray_capacity / 3, side = 1u << level, nodes = side * side;
+    unsigned long long total = npix * nodes;
+    cl_uint zero = 0, *marks = malloc(sizeof(cl_uint) * 2 * per);
+    if (!marks) return -1;
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->split, &zero, sizeof zero,
+                                 (size_t)(level % 2) * sizeof(cl_uint) * npix,
+                                 sizeof(cl_uint) * npix, 0, NULL, NULL),
+             fail);
+    pass->round = level;
+    for (unsigned long long done = 0; done < total; done += per) {
+        unsigned k = total - done < per ? (unsigned)(total - done) : per;
+        for (unsigned i = 0; i < k; i++) {
+            unsigned long long e = done + i;
+            unsigned node = (unsigned)(e % nodes);
+            marks[2 * i] = (cl_uint)(e / nodes);
+            marks[2 * i + 1] = aa_node_code(level, (int)(node % side), (int)(node / side));
+        }
+        CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->marks, CL_TRUE, 0, sizeof(cl_uint) * 2 * k,
+                                      marks, 0, NULL, NULL),
+                 fail);
+        if (aa_split_batch(aa, r, pass, 0, k, st)) goto fail;
+        aa_progress(pg, level, level + 1, st->samples, npix, (double)(done + k), (double)total);
+    }
+    free(marks);
+    return 0;
+fail:
+    free(marks);
+    return -1;
 }
 
 /* Ends refinement: each refined pixel becomes the mean of its cells (aa_resolve), the
@@ -283,6 +333,7 @@ static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba,
     size_t npix = (size_t)s->width * (size_t)s->height;
     cl_int none = -1, zero = 0;
     cl_uint counts[AA_COUNTS] = {0};
+    aa->npix = npix;
     aa->levels_host = malloc(sizeof(int) * npix); /* frame_render freed the last frame's */
     aa->leaves_host = malloc(sizeof(int) * npix);
     if (!aa->levels_host || !aa->leaves_host) {
@@ -354,7 +405,27 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
     VbAaPass pass;
     pass_init(&pass, s);
     st->samples = npix;
-    for (int round = 0; round < AA_MAX_ROUNDS; round++) {
+    /* below the minimum level every node splits, untested: every pixel takes a tree slot */
+    int forced = s->aa_min_level;
+    if (forced > 0) {
+        unsigned long long batch = npix << (2 * (forced - 1)), per = r->ray_capacity / 3;
+        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, batch < per ? batch : per,
+                        sizeof(cl_uint) * 2, 0, "mark list", err, errlen);
+        if (!rc) rc = aa_reserve_trees(aa, r, npix, 0, err, errlen);
+        if (!rc)
+            rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, npix, sizeof(cl_int), 0,
+                            "trees", err, errlen);
+        if (rc) goto out;
+        rc = 1;
+        pg.t_round = clu_now_ms();
+        for (int level = 0; level < forced; level++) {
+            if (aa_split_all(aa, r, &pass, level, st, &pg, npix)) goto fail;
+            st->aa_rounds++;
+            leaves += 3ull * (npix << (2 * level));
+        }
+        slots = (unsigned)npix;
+    }
+    for (int round = forced; round < AA_MAX_ROUNDS; round++) {
         cl_uint counts[AA_COUNTS];
         rc = aa_reserve(r, &aa->marks, &aa->mark_cap, leaves, sizeof(cl_uint) * 2, 0, "mark list",
                         err, errlen);

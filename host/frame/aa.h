@@ -21,6 +21,7 @@ typedef struct AaState {
     cl_mem levels, values, slot_pixels; /* tree_cap slots (slot_pixels slot_pixels_cap) */
     cl_mem marks;                       /* mark_cap entries of (pixel, node code) */
     size_t tree_cap, slot_pixels_cap, mark_cap;
+    size_t npix;      /* the frame's pixels: the most tree slots it can need */
     int *levels_host; /* after an adaptive render: each pixel's deepest level, else NULL */
     int *leaves_host; /* after an adaptive render: each pixel's number of leaves, else NULL */
 } AaState;

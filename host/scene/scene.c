@@ -225,18 +225,26 @@ static int get_choice(Ctx *c, const cJSON *j, const char *key, const char *name0
     return scene_fail(c, path, "expected \"%s\" or \"%s\"", name0, name1);
 }
 
-/* render.aa, render.aa_max_level, render.aa_floor, render.aa_level_gain,
- * render.aa_reconstruct, render.aa_pairs: adaptive anti-aliasing. */
+/* render.aa, render.aa_max_level, render.aa_min_level, render.aa_floor,
+ * render.aa_level_gain, render.aa_reconstruct, render.aa_pairs: adaptive anti-aliasing. */
 static int get_aa(Ctx *c, const cJSON *j, Scene *s)
 {
-    return get_choice(c, j, "aa_reconstruct", "nearest", "leaves", &s->aa_reconstruct) ||
-           get_choice(c, j, "aa_pairs", "first", "both", &s->aa_pairs) ||
-           json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
-           json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
-                        &s->aa_max_level) ||
-           json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor) ||
-           json_get_float(c, j, "render", "aa_level_gain", 1, 4, SCENE_AA_LEVEL_GAIN, 0,
-                          &s->aa_level_gain);
+    if (get_choice(c, j, "aa_reconstruct", "nearest", "leaves", &s->aa_reconstruct) ||
+        get_choice(c, j, "aa_pairs", "first", "both", &s->aa_pairs) ||
+        json_get_float(c, j, "render", "aa", 0, 1, 0, 0, &s->aa_threshold) ||
+        json_get_int(c, j, "render", "aa_max_level", 1, VBCL_AA_MAX_LEVEL, VBCL_AA_MAX_LEVEL, 0,
+                     &s->aa_max_level) ||
+        json_get_int(c, j, "render", "aa_min_level", 0, VBCL_AA_MAX_LEVEL, 0, 0,
+                     &s->aa_min_level) ||
+        json_get_float(c, j, "render", "aa_floor", 0, 2, SCENE_AA_FLOOR, 0, &s->aa_floor) ||
+        json_get_float(c, j, "render", "aa_level_gain", 1, 4, SCENE_AA_LEVEL_GAIN, 0,
+                       &s->aa_level_gain))
+        return -1;
+    if (s->aa_min_level > s->aa_max_level)
+        return scene_fail(c, "render.aa_min_level",
+                          "expected at most render.aa_max_level (%d), got %d", s->aa_max_level,
+                          s->aa_min_level);
+    return 0;
 }
 
 /* render.<key>, when present: true or false into *v. */
@@ -269,6 +277,7 @@ static void render_defaults(Scene *s)
     s->min_weight = 1e-3f;
     s->aa_threshold = 0.0f;
     s->aa_max_level = VBCL_AA_MAX_LEVEL;
+    s->aa_min_level = 0;
     s->aa_floor = SCENE_AA_FLOOR;
     s->aa_level_gain = SCENE_AA_LEVEL_GAIN;
     s->aa_reconstruct = SCENE_AA_NEAREST;
@@ -296,6 +305,7 @@ static int load_render(Ctx *c, const cJSON *j, Scene *s)
                                        "min_weight",
                                        "aa",
                                        "aa_max_level",
+                                       "aa_min_level",
                                        "aa_floor",
                                        "aa_level_gain",
                                        "aa_reconstruct",

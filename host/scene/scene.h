@@ -107,6 +107,7 @@ typedef struct Scene {
     float min_weight;     /* ray-tree pruning threshold */
     float aa_threshold;   /* adaptive anti-aliasing contrast threshold; 0: off */
     int aa_max_level;     /* deepest refinement level: 2^level x 2^level samples (1..4) */
+    int aa_min_level;     /* every pixel is split down to this level untested (0..aa_max_level) */
     float aa_floor;       /* the contrast's a + b counts as at least this (SCENE_AA_FLOOR) */
     float aa_level_gain;  /* a leaf at level L fails at aa_threshold * gain^L (1: the thesis) */
     int aa_reconstruct;   /* SCENE_AA_NEAREST or SCENE_AA_LEAVES */
