@@ -358,7 +358,21 @@ def part_error(a, out):
                           "Run time against error: anti-aliasing",
                           "Against `--ssaa 16` of the same scene with another seed "
                           "(scripts/bench_aa.py).")
-    return aa_text + "\n" + text
+    with open(os.path.join(out, "aa_path_cost.csv")) as f:
+        path_rows = list(csv.DictReader(f))
+    path_text = write_table(out, "aa_path_cost", path_rows,
+                            ["scene", "size", "samples_per_pixel", "variant", "rounds",
+                             "uniform_us_per_sample", "tracing_us_per_sample", "tracing_ratio",
+                             "refinement_us_per_sample", "refinement_ratio"],
+                            "Per sample: refinement against uniform supersampling",
+                            "The same samples through both paths: the quadtree forced to one "
+                            "level in every pixel (`--aa 1 --aa-min-level L --aa-max-level L`) "
+                            "against `--ssaa 2^L`, interleaved rounds, medians; ratios are "
+                            "medians of per-round ratios. Tracing: refinement's batches "
+                            "(aa.refine_ms) per refined sample; refinement: with the contrast "
+                            "passes, split stores and nearest-sample resolve; uniform: all its "
+                            "kernels per sample (scripts/bench_aa.py).")
+    return aa_text + "\n" + path_text + "\n" + text
 
 
 # Part 7: figure A.4 by acceleration structure (--grid), at the thesis's 400x400: the

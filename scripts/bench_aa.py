@@ -17,6 +17,14 @@ Cost per sample: device time of the tracing kernels per camera ray (us), for ada
 refinement its own batches (aa.refine_ms / rays.refinement), for uniform all of them
 (time_ms.kernels / samples.total); and the same per traced ray, camera rays plus their
 shadow feelers and ray-tree rays (for refinement: the rays beyond those of the plain render).
+Path cost (OUT/aa_path_cost.csv): the same samples through both paths, so that where
+adaptive samples lie (the expensive parts of an image) does not enter the comparison: the
+quadtree forced to one level everywhere (--aa 1 --aa-min-level L --aa-max-level L, 4^L
+samples in every pixel) against --ssaa 2^L, in interleaved rounds; device time per sample of
+refinement's tracing batches (aa.refine_ms over the refinement's samples), of all of
+refinement (contrast, tracing, split stores and the nearest-sample resolve), and of uniform
+supersampling (all its kernels), with per-round ratios. "no shares": the quadtree with
+--no-sample-shares, whose ray-tree points take the feelers uniform's do.
 --quick renders tiny images (for CI: well under a minute).
 """
 import argparse
@@ -167,6 +175,10 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for scene, label, size, extra in scenes:
             rows += bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats)
+        path_rows = []
+        for scene, label, size, extra in scenes:
+            path_rows += path_cost(a, tmp, scene, size, extra, repeats)
+    write_csv(os.path.join(a.out, "aa_path_cost.csv"), path_rows)
     csv_path = os.path.join(a.out, "aa_time_error.csv")
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k != "label"],
@@ -175,6 +187,65 @@ def main():
         w.writerows(rows)
     plot(rows, scenes, os.path.join(a.out, "aa_time_error.png"))
     print(f"bench_aa: wrote {csv_path} and {os.path.join(a.out, 'aa_time_error.png')}")
+
+
+def write_csv(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+PATH_LEVELS_FULL = [1, 2]
+PATH_LEVELS_QUICK = [1]
+
+
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+
+
+def path_cost(a, tmp, scene, size, extra, repeats):
+    """Rows of the path-cost comparison for one scene (module docstring): per level, the
+    medians over interleaved rounds (at least 5; one warm-up round first)."""
+    name = os.path.splitext(os.path.basename(scene))[0]
+    npix = size * size
+    out = os.path.join(tmp, "path.exr")
+    rows = []
+    for level in PATH_LEVELS_QUICK if a.quick else PATH_LEVELS_FULL:
+        forced = ["--aa", "1", "--aa-min-level", str(level), "--aa-max-level", str(level)]
+        variants = (("uniform", ["--ssaa", str(1 << level)]), ("quadtree", forced),
+                    ("quadtree, no shares", forced + ["--no-sample-shares"]))
+        got = {v: [] for v, _ in variants}
+        rounds = 1 if a.quick else max(repeats, 5)
+        for r in range(rounds + (0 if a.quick else 1)):
+            for v, opts in variants:
+                st = render(a.vbcl, scene, size, extra, opts, out, full=True)
+                n, aa = st["samples"]["total"], st["aa"]
+                if v == "uniform":
+                    trace = whole = st["time_ms"]["kernels"] / n
+                else:
+                    refined = n - npix
+                    trace = aa["refine_ms"] / refined
+                    whole = (aa["contrast_ms"] + aa["refine_ms"] + aa["reconstruct_ms"]) / refined
+                if r or a.quick:  # the first round warms the kernels up
+                    got[v].append((1000.0 * trace, 1000.0 * whole))
+        for v, _ in variants[1:]:
+            ratio_t = median([q[0] / u[0] for q, u in zip(got[v], got["uniform"])])
+            ratio_w = median([q[1] / u[1] for q, u in zip(got[v], got["uniform"])])
+            row = {"scene": name, "size": f"{size}x{size}", "samples_per_pixel": 1 << (2 * level),
+                   "variant": v, "rounds": len(got[v]),
+                   "uniform_us_per_sample": f"{median([u[0] for u in got['uniform']]):.3f}",
+                   "tracing_us_per_sample": f"{median([q[0] for q in got[v]]):.3f}",
+                   "tracing_ratio": f"{ratio_t:.3f}",
+                   "refinement_us_per_sample": f"{median([q[1] for q in got[v]]):.3f}",
+                   "refinement_ratio": f"{ratio_w:.3f}"}
+            rows.append(row)
+            print(f"{name:22s} path cost {1 << level}x{1 << level} {v:20s} tracing "
+                  f"{row['tracing_ratio']} x uniform, all of refinement "
+                  f"{row['refinement_ratio']} x", flush=True)
+    return rows
 
 
 def bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats):
