@@ -412,6 +412,20 @@ static void test_aa_min_level(void)
           e1, adapt.samples_mean, ea);
     CHECK(rmse(&min0, &adapt) == 0.0 && min0.samples_mean == adapt.samples_mean,
           "a minimum of 0 differs from the default: %g", rmse(&min0, &adapt));
+    /* a slot per pixel that no device holds (16384^2 x 5,440 bytes): refused, naming the
+     * option, writing nothing (aa_check_fits refuses it before pass 0, which would take
+     * minutes here) */
+    char cmd[1024], log[4096], big[512];
+    snprintf(big, sizeof big, "%s/aa_min_big.png", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             "%s %s --width 16384 --height 16384 --aa 0.1 --aa-min-level 1 -q -o %s", tu_vbcl,
+             AA_SCENE, big);
+    int rc = tu_run(cmd, log, sizeof log);
+    FILE *f = fopen(big, "rb");
+    CHECK(rc != 0 && strstr(log, "--aa-min-level") && !f,
+          "16384^2 with a minimum level: exit %d, %s: %s", rc, f ? "an image written" : "no image",
+          log);
+    if (f) fclose(f);
     AaRender *all[] = {&ref, &u2, &u4, &full, &adapt, &min0, &min1};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) aa_free(all[i]);
 }

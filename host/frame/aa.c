@@ -59,6 +59,14 @@ static int aa_capacity(const VbDevice *d, size_t need, size_t elem, const char *
     return 2;
 }
 
+int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen)
+{
+    size_t want, npix = (size_t)s->width * (size_t)s->height;
+    if (s->ssaa > 1 || !(s->aa_threshold > 0.0f) || s->aa_min_level == 0) return 0;
+    return aa_capacity(r->dev, npix, sizeof(float) * 4 * AA_TREE_NODES, "trees", &want, err,
+                       errlen);
+}
+
 /* Makes *buf hold at least `need` elements of `elem` bytes (capacity *cap), keeping its
  * first `keep` elements: a new buffer (aa_capacity), the old contents copied. Returns 0, 1
  * (device) or 2 (more than one allocation allows) with a message in err. */

@@ -40,6 +40,11 @@ typedef struct AaState {
 int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
               char *err, size_t errlen);
 
+/* Whether a frame of s fits r's device before anything is traced: with a minimum level
+ * (s->aa_min_level) every pixel takes a tree slot. Returns 0, or 2 with a message in err
+ * (as aa_refine would after pass 0). */
+int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen);
+
 /* Renders rgba with n x n samples at the subpixel centres of every pixel (n in 1..16),
  * box-filtered. Returns as aa_refine. */
 int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st,

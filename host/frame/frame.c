@@ -66,7 +66,8 @@ int frame_render(Frame *fr, const Scene *s, float *rgba, RenderStats *st, int pr
     if (s->ssaa > 1) {
         rc = aa_supersample(&fr->aa, &fr->r, s, s->ssaa, rgba, st, err, errlen);
     } else {
-        rc = frame_pixel_centres(fr, s, rgba, st, progress, err, errlen);
+        rc = aa_check_fits(&fr->r, s, err, errlen);
+        if (!rc) rc = frame_pixel_centres(fr, s, rgba, st, progress, err, errlen);
         before = *st;
         t_first = clu_now_ms();
         st->samples = (unsigned long long)npix;
