@@ -77,13 +77,33 @@ AA_TREE_FN int aa_node_sample_cell(int level, int x, int y)
 }
 
 /* Which of the four children of node `code` (0 .. 3: x | y << 1 within the node) holds
- * its sample. */
+ * its sample, without walking the sample cells (aa_node_sample_cell, which this equals over
+ * every node: test_aa_samples_nested_never_retraced). Down from the pixel, whose centre
+ * (8, 8) child 3 holds: a child that does not hold its parent's sample takes its fresh cell,
+ * which its own child of the same parity (x & 1, y & 1) holds; the fresh cell lies beside
+ * the node's centre lines, so it sits in a corner of every deeper node that holds it: the
+ * holder's child opposite its owner's parity holds it next, and each one after that the
+ * child of its own parity. */
 AA_TREE_FN int aa_kept_index(unsigned int code)
 {
-    int level = aa_node_level(code);
-    int cell = aa_node_sample_cell(level, aa_node_x(code), aa_node_y(code));
-    int s = AA_TREE_SIDE >> (level + 1);
-    return ((cell / AA_TREE_SIDE / s) & 1) * 2 + ((cell % AA_TREE_SIDE / s) & 1);
+    int level = aa_node_level(code), x = aa_node_x(code), y = aa_node_y(code);
+    int k = 3, owner = 1; /* the pixel: child 3 holds (8, 8), which the pixel owns */
+    for (int l = 1; l <= level; l++) {
+        int sh = level - l, p = ((y >> sh) & 1) << 1 | ((x >> sh) & 1);
+        int held = p == k; /* this ancestor holds its parent's sample */
+        k = held && owner ? p ^ 3 : p;
+        owner = !held;
+    }
+    return k;
+}
+
+/* The sample cell of a child that does not hold its parent's sample (aa_new_child): its
+ * fresh cell, the central cell farthest from the parent's centre (aa_node_sample_cell
+ * without the walk). */
+AA_TREE_FN int aa_new_child_cell(unsigned int child)
+{
+    int s = AA_TREE_SIDE >> aa_node_level(child), x = aa_node_x(child), y = aa_node_y(child);
+    return aa_fresh_cell(y * s, s, y & 1) * AA_TREE_SIDE + aa_fresh_cell(x * s, s, x & 1);
 }
 
 /* Child c (0 .. 3: x | y << 1 within the node) of node `code`. */

@@ -433,7 +433,7 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     if (i >= nrays) return;
     uint2 m = marks[aa->first + (uint)i / 3u];
     uint child = aa_new_child(m.y, i % 3);
-    int cell = aa_node_sample_cell(aa_node_level(child), aa_node_x(child), aa_node_y(child));
+    int cell = aa_new_child_cell(child);
     float2 at = aa_cell_position(cell);
     int x = (int)(m.x % (uint)f->width), y = (int)(m.x / (uint)f->width);
     rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,

@@ -447,7 +447,8 @@ static void split_leaf(unsigned *leaves, int *n, int i)
 
 /* The nested sample positions (kernels/aa_tree.h), checked over every node: a node's
  * sample cell lies inside it; of its four children exactly one holds the node's sample,
- * the three new children (aa_new_child) are the other three, each with its sample inside
+ * the one aa_kept_index names, the three new children (aa_new_child) are the other three,
+ * each with its sample (aa_new_child_cell: the cell the walk finds) inside
  * it; the pixel centre's cell is never a new sample. Then random refinements of a pixel:
  * the samples traced (the centre, then three per split) never repeat, and they are exactly
  * the samples of the leaves. */
@@ -466,10 +467,17 @@ static void test_aa_samples_nested_never_retraced(void)
                 for (int c = 0; c < 4; c++)
                     holders +=
                         aa_node_sample_cell(lv + 1, 2 * x + (c & 1), 2 * y + (c >> 1)) == cell;
+                unsigned kept = aa_kept_child(code);
+                CHECK(aa_node_sample_cell(lv + 1, aa_node_x(kept), aa_node_y(kept)) == cell,
+                      "node (%d, %d, %d): aa_kept_index %d does not hold its sample", lv, x, y,
+                      aa_kept_index(code));
                 for (int j = 0; j < 3; j++) {
                     unsigned ch = aa_new_child(code, j);
                     int cx = aa_node_x(ch), cy = aa_node_y(ch);
                     int cc = aa_node_sample_cell(lv + 1, cx, cy);
+                    CHECK(aa_new_child_cell(ch) == cc,
+                          "node (%d, %d, %d): new child %d's cell %d, walked %d", lv, x, y, j,
+                          aa_new_child_cell(ch), cc);
                     CHECK(aa_node_level(ch) == lv + 1 && cx / 2 == x && cy / 2 == y,
                           "node (%d, %d, %d): new child %d is no child", lv, x, y, j);
                     CHECK(cc != cell && cc != AA_TREE_CENTRE_CELL,
