@@ -234,7 +234,7 @@ VB_INLINE int light_cone_meets(const LightCone *k, __global const VbObject *ob)
  * triangle tri tests: a part without it lies wholly behind that triangle's plane. */
 VB_INLINE uint part_ahead_bit(__global const VbObject *ob, int tri)
 {
-    return ob->ntris <= 32u ? 1u << ((uint)tri - ob->first_tri) : 0xffffffffu;
+    return ob->ntris <= (uint)VBCL_AHEAD_BITS ? 1u << ((uint)tri - ob->first_tri) : 0xffffffffu;
 }
 
 /* The triangles that feelers from ls->origin toward the light sphere (radius r, 0 for a

@@ -188,13 +188,17 @@ typedef struct VbObject {
                             * (nelems 0) and they and its own fit in a set together */
     unsigned int ahead;    /* a texture part's record: bit j set where the part may reach ahead
                             * of the plane of its host's own triangle host.first_tri + j (host
-                            * of at most 32 own triangles; of more, all bits set, or none where
-                            * it lies within the host's inner sphere); clear only where it lies
+                            * of at most VBCL_AHEAD_BITS own triangles; of more, all bits set, or none
+                            * where    it lies within the host's inner sphere); clear only where it lies
                             * behind that plane by a margin, so that a ray or feeler leaving the
                             * host through the front of that triangle cannot meet it
                             * (part_ahead_bit). All set for a host that is not VBCL_OBJECT_HULL */
     unsigned int pad[3];
 } VbObject;
+
+/* The own triangles a host may have for a bit of VbObject.ahead each: the bits of an unsigned
+ * int (the host's parts_ahead and the kernels' part_ahead_bit). */
+#define VBCL_AHEAD_BITS 32
 
 /* The shadow cone test's sets of triangles (kernels/scene.cl, ObjectSet): at most this many
  * triangles in all; a record of more than half of it is tested by its bounds instead. */
@@ -414,6 +418,7 @@ VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
 VBCL_STATIC_ASSERT(sizeof(VbObject) == 144, object_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ahead) == 128, object_ahead);
+VBCL_STATIC_ASSERT(VBCL_AHEAD_BITS == 8 * sizeof(unsigned int), object_ahead_bits);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, own) == 104, object_own);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tri) == 120, object_quad_tri);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, quad_tex) == 124, object_quad_tex);

@@ -688,15 +688,15 @@ static void host_inner(const Mesh *m, VbObject *g, uint32_t first, uint32_t n, d
 
 /* Clears bits of the parts' VbObject.ahead (all set by objects_make) for host record g, whose
  * own triangles first .. first + n - 1 of m bound a convex volume (VBCL_OBJECT_HULL): for a
- * host of at most 32 of them (part_ahead_bit), bit j where every vertex of the part lies
- * behind the plane of triangle first + j by at least margin (the part lies wholly behind it:
+ * host of at most VBCL_AHEAD_BITS of them (part_ahead_bit), bit j where every vertex of the part
+ * lies behind the plane of triangle first + j by at least margin (the part lies wholly behind it:
  * a ray leaving the host through the front of that triangle, ahead of its plane from then on,
  * cannot meet the part); for a larger host, every bit where the part's bounding sphere lies
  * within the host's inner sphere (VBCL_OBJECT_INNER) by margin, behind every plane of it. */
 static void parts_ahead(const Mesh *m, const VbObject *g, uint32_t first, uint32_t n,
                         VbObject *parts, int nparts, double margin)
 {
-    if (n > 32) {
+    if (n > VBCL_AHEAD_BITS) {
         for (int e = 0; e < nparts && (g->flags & VBCL_OBJECT_INNER); e++) {
             double d2 = 0.0;
             for (int a = 0; a < 3; a++)
