@@ -188,11 +188,12 @@ typedef struct VbObject {
                             * (nelems 0) and they and its own fit in a set together */
     unsigned int ahead;    /* a texture part's record: bit j set where the part may reach ahead
                             * of the plane of its host's own triangle host.first_tri + j (host
-                            * of at most VBCL_AHEAD_BITS own triangles; of more, all bits set, or none
-                            * where    it lies within the host's inner sphere); clear only where it lies
-                            * behind that plane by a margin, so that a ray or feeler leaving the
-                            * host through the front of that triangle cannot meet it
-                            * (part_ahead_bit). All set for a host that is not VBCL_OBJECT_HULL */
+                            * of at most VBCL_AHEAD_BITS own triangles; of more, all bits set,
+                            * or none where it lies within the host's inner sphere); clear only
+                            * where it lies behind that plane by a margin, so that a ray or
+                            * feeler leaving the host through the front of that triangle cannot
+                            * meet it (part_ahead_bit). All set for a host that is not
+                            * VBCL_OBJECT_HULL */
     unsigned int pad[3];
 } VbObject;
 
