@@ -32,6 +32,7 @@ import csv
 import json
 import os
 import re
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -180,30 +181,22 @@ def main():
             path_rows += path_cost(a, tmp, scene, size, extra, repeats)
     write_csv(os.path.join(a.out, "aa_path_cost.csv"), path_rows)
     csv_path = os.path.join(a.out, "aa_time_error.csv")
-    with open(csv_path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k != "label"],
-                           extrasaction="ignore")
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(csv_path, rows, skip=("label",))
     plot(rows, scenes, os.path.join(a.out, "aa_time_error.png"))
     print(f"bench_aa: wrote {csv_path} and {os.path.join(a.out, 'aa_time_error.png')}")
 
 
-def write_csv(path, rows):
+def write_csv(path, rows, skip=()):
+    """rows (dicts) as CSV, the first row's keys less skip as the columns."""
     with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k not in skip],
+                           extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
 
 
 PATH_LEVELS_FULL = [1, 2]
 PATH_LEVELS_QUICK = [1]
-
-
-def median(xs):
-    xs = sorted(xs)
-    n = len(xs)
-    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
 
 
 def path_cost(a, tmp, scene, size, extra, repeats):
@@ -232,14 +225,14 @@ def path_cost(a, tmp, scene, size, extra, repeats):
                 if r or a.quick:  # the first round warms the kernels up
                     got[v].append((1000.0 * trace, 1000.0 * whole))
         for v, _ in variants[1:]:
-            ratio_t = median([q[0] / u[0] for q, u in zip(got[v], got["uniform"])])
-            ratio_w = median([q[1] / u[1] for q, u in zip(got[v], got["uniform"])])
+            ratio_t = statistics.median([q[0] / u[0] for q, u in zip(got[v], got["uniform"])])
+            ratio_w = statistics.median([q[1] / u[1] for q, u in zip(got[v], got["uniform"])])
             row = {"scene": name, "size": f"{size}x{size}", "samples_per_pixel": 1 << (2 * level),
                    "variant": v, "rounds": len(got[v]),
-                   "uniform_us_per_sample": f"{median([u[0] for u in got['uniform']]):.3f}",
-                   "tracing_us_per_sample": f"{median([q[0] for q in got[v]]):.3f}",
+                   "uniform_us_per_sample": f"{statistics.median([u[0] for u in got['uniform']]):.3f}",
+                   "tracing_us_per_sample": f"{statistics.median([q[0] for q in got[v]]):.3f}",
                    "tracing_ratio": f"{ratio_t:.3f}",
-                   "refinement_us_per_sample": f"{median([q[1] for q in got[v]]):.3f}",
+                   "refinement_us_per_sample": f"{statistics.median([q[1] for q in got[v]]):.3f}",
                    "refinement_ratio": f"{ratio_w:.3f}"}
             rows.append(row)
             print(f"{name:22s} path cost {1 << level}x{1 << level} {v:20s} tracing "
