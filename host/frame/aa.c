@@ -260,18 +260,17 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
 }
 
 /* Round `level` of the rounds below s->aa_min_level, which split every node of every pixel
- * at that level without a contrast test: the host lists the nodes a batch at a time, in
- * pixel order (into aa->marks, which must hold a batch), clears this round's half of aa->split
- * (aa_contrast_mark's work in a tested round) and splits them as aa_split does. Returns 0
- * or -1. */
-static int aa_split_all(AaState *aa, Renderer *r, VbAaPass *pass, int level, RenderStats *st,
-                        AaProgress *pg, unsigned long long npix)
+ * at that level without a contrast test: the host lists the nodes `per` at a time, in pixel
+ * order (into marks, then aa->marks, each holding per entries), clears this round's half of
+ * aa->split (aa_contrast_mark's work in a tested round) and splits them as aa_split does.
+ * Returns 0 or -1. */
+static int aa_split_all(AaState *aa, Renderer *r, VbAaPass *pass, int level, cl_uint *marks,
+                        unsigned per, RenderStats *st, AaProgress *pg, unsigned long long npix)
 {
     VbDevice *d = r->dev;
-    unsigned per = (unsigned)r->ray_capacity / 3, side = 1u << level, nodes = side * side;
+    unsigned side = 1u << level, nodes = side * side;
     unsigned long long total = npix * nodes;
-    cl_uint zero = 0, *marks = malloc(sizeof(cl_uint) * 2 * per);
-    if (!marks) return -1;
+    cl_uint zero = 0;
     CL_CHECK(clEnqueueFillBuffer(d->queue, aa->split, &zero, sizeof zero,
                                  (size_t)(level % 2) * sizeof(cl_uint) * npix,
                                  sizeof(cl_uint) * npix, 0, NULL, NULL),
@@ -291,10 +290,8 @@ static int aa_split_all(AaState *aa, Renderer *r, VbAaPass *pass, int level, Ren
         if (aa_split_batch(aa, r, pass, 0, k, st)) goto fail;
         aa_progress(pg, level, level + 1, st->samples, npix, (double)(done + k), (double)total);
     }
-    free(marks);
     return 0;
 fail:
-    free(marks);
     return -1;
 }
 
@@ -416,21 +413,32 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
     /* below the minimum level every node splits, untested: every pixel takes a tree slot */
     int forced = s->aa_min_level;
     if (forced > 0) {
-        unsigned long long batch = npix << (2 * (forced - 1)), per = r->ray_capacity / 3;
-        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, batch < per ? batch : per,
-                        sizeof(cl_uint) * 2, 0, "mark list", err, errlen);
+        unsigned long long most = npix << (2 * (forced - 1)); /* the last round's nodes */
+        unsigned per = (unsigned)r->ray_capacity / 3;
+        if (most < per) per = (unsigned)most;
+        cl_uint *marks = malloc(sizeof(cl_uint) * 2 * per);
+        if (!marks) {
+            snprintf(err, errlen, "out of memory");
+            rc = 1;
+            goto out;
+        }
+        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, per, sizeof(cl_uint) * 2, 0, "mark list", err,
+                        errlen);
         if (!rc) rc = aa_reserve_trees(aa, r, npix, 0, err, errlen);
         if (!rc)
             rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, npix, sizeof(cl_int), 0,
                             "trees", err, errlen);
-        if (rc) goto out;
-        rc = 1;
         pg.t_round = clu_now_ms();
-        for (int level = 0; level < forced; level++) {
-            if (aa_split_all(aa, r, &pass, level, st, &pg, npix)) goto fail;
-            st->aa_rounds++;
+        int failed = 0; /* a device error, which fail formats */
+        for (int level = 0; !rc && !failed && level < forced; level++) {
+            failed = aa_split_all(aa, r, &pass, level, marks, per, st, &pg, npix) != 0;
+            st->aa_rounds += !failed;
             leaves += 3ull * (npix << (2 * level));
         }
+        free(marks);
+        if (rc) goto out;
+        rc = 1;
+        if (failed) goto fail;
         slots = (unsigned)npix;
     }
     for (int round = forced; round < AA_MAX_ROUNDS; round++) {
