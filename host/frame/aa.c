@@ -295,6 +295,39 @@ fail:
     return -1;
 }
 
+/* The rounds below the minimum level `forced` (aa_split_all, one per level), with room made
+ * for every pixel's tree slot and a batch of host-listed nodes. Returns 0, or 1 (device) / 2
+ * (too large) with a message in err. */
+static int aa_split_levels(AaState *aa, Renderer *r, VbAaPass *pass, int forced, RenderStats *st,
+                           AaProgress *pg, unsigned long long npix, char *err, size_t errlen)
+{
+    unsigned long long most = npix << (2 * (forced - 1)); /* the last round's nodes */
+    unsigned per = (unsigned)r->ray_capacity / 3;
+    if (most < per) per = (unsigned)most;
+    cl_uint *marks = malloc(sizeof(cl_uint) * 2 * per);
+    if (!marks) {
+        snprintf(err, errlen, "out of memory");
+        return 1;
+    }
+    int rc = aa_reserve(r, &aa->marks, &aa->mark_cap, per, sizeof(cl_uint) * 2, 0, "mark list", err,
+                        errlen);
+    if (!rc) rc = aa_reserve_trees(aa, r, npix, 0, err, errlen);
+    if (!rc)
+        rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, npix, sizeof(cl_int), 0, "trees",
+                        err, errlen);
+    pg->t_round = clu_now_ms();
+    for (int level = 0; !rc && level < forced; level++) {
+        if (aa_split_all(aa, r, pass, level, marks, per, st, pg, npix)) {
+            snprintf(err, errlen, "%s: %s", r->dev->name, clu_error());
+            rc = 1;
+        } else {
+            st->aa_rounds++;
+        }
+    }
+    free(marks);
+    return rc;
+}
+
 /* Ends refinement: each refined pixel becomes the mean of its cells (aa_resolve), the
  * film and each pixel's deepest level and leaf count come back, and st gets the samples
  * per pixel (max) and the pixels that reached each level. Returns 0 or -1. */
@@ -413,32 +446,9 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
     /* below the minimum level every node splits, untested: every pixel takes a tree slot */
     int forced = s->aa_min_level;
     if (forced > 0) {
-        unsigned long long most = npix << (2 * (forced - 1)); /* the last round's nodes */
-        unsigned per = (unsigned)r->ray_capacity / 3;
-        if (most < per) per = (unsigned)most;
-        cl_uint *marks = malloc(sizeof(cl_uint) * 2 * per);
-        if (!marks) {
-            snprintf(err, errlen, "out of memory");
-            rc = 1;
-            goto out;
-        }
-        rc = aa_reserve(r, &aa->marks, &aa->mark_cap, per, sizeof(cl_uint) * 2, 0, "mark list", err,
-                        errlen);
-        if (!rc) rc = aa_reserve_trees(aa, r, npix, 0, err, errlen);
-        if (!rc)
-            rc = aa_reserve(r, &aa->slot_pixels, &aa->slot_pixels_cap, npix, sizeof(cl_int), 0,
-                            "trees", err, errlen);
-        pg.t_round = clu_now_ms();
-        int failed = 0; /* a device error, which fail formats */
-        for (int level = 0; !rc && !failed && level < forced; level++) {
-            failed = aa_split_all(aa, r, &pass, level, marks, per, st, &pg, npix) != 0;
-            st->aa_rounds += !failed;
-            leaves += 3ull * (npix << (2 * level));
-        }
-        free(marks);
+        rc = aa_split_levels(aa, r, &pass, forced, st, &pg, npix, err, errlen);
         if (rc) goto out;
-        rc = 1;
-        if (failed) goto fail;
+        leaves = npix << (2 * forced);
         slots = (unsigned)npix;
     }
     for (int round = forced; round < AA_MAX_ROUNDS; round++) {
