@@ -23,8 +23,9 @@ quadtree forced to one level everywhere (--aa 1 --aa-min-level L --aa-max-level 
 samples in every pixel) against --ssaa 2^L, in interleaved rounds; device time per sample of
 refinement's tracing batches (aa.refine_ms over the refinement's samples), of all of
 refinement (contrast, tracing, split stores and the nearest-sample resolve), and of uniform
-supersampling (all its kernels), with per-round ratios. "no shares": the quadtree with
---no-sample-shares, whose ray-tree points take the feelers uniform's do.
+supersampling (all its kernels), with per-round ratios, on images of at least 128x128
+(PATH_MIN_SIZE). "no shares": the quadtree with --no-sample-shares, whose ray-tree points
+take the feelers uniform's do.
 --quick renders tiny images (for CI: well under a minute).
 """
 import argparse
@@ -197,12 +198,19 @@ def write_csv(path, rows, skip=()):
 
 PATH_LEVELS_FULL = [1, 2]
 PATH_LEVELS_QUICK = [1]
+# The path cost's smallest image side (not --quick): per-batch costs (kernel launches, the
+# ray trees' rounds) are shared by a batch's samples, and a forced 2x2 refinement counts 3
+# of a pixel's 4 samples against uniform's 4, so a small image charges the quadtree up to
+# 4/3 of them per sample. glass_bombed_sphere at 64x64 is one batch of 12,288 rays there,
+# and uniform's own cost per sample was 1.76x its cost at 128x128 (docs/benchmarks.md).
+PATH_MIN_SIZE = 128
 
 
 def path_cost(a, tmp, scene, size, extra, repeats):
     """Rows of the path-cost comparison for one scene (module docstring): per level, the
     medians over interleaved rounds (at least 5; one warm-up round first)."""
     name = os.path.splitext(os.path.basename(scene))[0]
+    size = size if a.quick else max(size, PATH_MIN_SIZE)
     npix = size * size
     out = os.path.join(tmp, "path.exr")
     rows = []
