@@ -10,6 +10,8 @@
  *                                                 subtrees (only with VBCL_HAS_DISPERSION)
  *   aa_reconstruct          radiance           -> film (--ssaa: box window per pixel)
  *   aa_contrast_mark        film, trees        -> marks (quadtree leaves to split)
+ *   aa_contrast_list        film, trees, list  -> marks (the same, for listed pixels)
+ *   aa_dirty_list           marks              -> list (the pixels the next round tests)
  *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
  *   aa_split_store          radiance, marks    -> trees (four leaves for each split node)
  *   aa_resolve              trees, slots       -> film, info (each pixel from its samples)
@@ -376,25 +378,17 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float
     vstore4(sum * (1.0f / (float)n), aa->first + j, film);
 }
 
-/* film, slots, trees, split -> marks, counts: over the whole image, every leaf below the
- * top level against its adjacent leaves (aa_leaf_fails): in round 0 all, later those in
- * pixels whose neighbourhood was split last round (aa_pixel_dirty) that lie in or
- * next to a block split last round (aa_leaf_touched; split holds two rounds' blocks, the
- * last round's read and this round's cleared); a failing leaf is appended to marks as
- * (pixel, node code). counts[0] counts the marks, counts[1 + l] those at level l. */
-__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
-                               __global const int *slots, __global const uchar *levels,
-                               __global const float *values, __global uint2 *marks,
-                               __global uint *counts, __global uint *split)
+/* The contrast test of pixel p (x, y) in a round (aa_contrast_mark, aa_contrast_list): an
+ * unsplit pixel against its neighbours, or each leaf of a split one below the top level
+ * against its adjacent leaves (aa_leaf_fails), after round 0 only the leaves that lie in or
+ * next to a block split last round (aa_leaf_touched; last: the last round's half of split).
+ * A failing leaf is appended to marks as (pixel, node code); counts[0] counts the marks,
+ * counts[1 + l] those at level l. */
+VB_INLINE void aa_contrast_pixel(__constant const VbAaPass *aa, __global const float *film,
+                                 __global const int *slots, AaTree tree, __global uint2 *marks,
+                                 __global uint *counts, __global const uint *last, int p)
 {
-    int p = get_global_id(0), npix = aa->width * aa->height;
-    AaTree tree = {levels, values, aa->tree_cap};
-    if (p >= npix) return;
-    /* this round's splits are recorded in the other half of split[] */
-    __global const uint *last = split + (aa->round + 1) % 2 * npix;
-    split[aa->round % 2 * npix + p] = 0u;
     int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
-    if (!aa_pixel_dirty(aa, last, x, y)) return;
     if (slot < 0) {
         float3 a = aa_display(aa, vload4(p, film).xyz);
         int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
@@ -407,7 +401,7 @@ __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const flo
         marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
         return;
     }
-    __global const uchar *own = levels + (size_t)slot * VBCL_AA_CELLS;
+    __global const uchar *own = tree.levels + (size_t)slot * VBCL_AA_CELLS;
     for (int fy = 0; fy < AA_TREE_SIDE; fy++) /* each row one leaf at a time */
         for (int fx = 0; fx < AA_TREE_SIDE;) {
             int lv = own[fy * AA_TREE_SIDE + fx], s = AA_TREE_SIDE >> lv, at = fx;
@@ -415,11 +409,64 @@ __kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const flo
             if (lv >= aa->max_level || fy % s) continue; /* not the leaf's first row */
             int X0 = x * AA_TREE_SIDE + at, Y0 = y * AA_TREE_SIDE + fy;
             if (aa->round > 0 && !aa_leaf_touched(aa, last, X0, Y0, s)) continue;
-            float3 c = vload4(aa_cell_value(tree.cap, slot, lv, at, fy), values).xyz;
+            float3 c = vload4(aa_cell_value(tree.cap, slot, lv, at, fy), tree.values).xyz;
             if (!aa_leaf_fails(aa, film, slots, tree, X0, Y0, s, lv, aa_display(aa, c))) continue;
             uint m = atomic_inc(&counts[0]);
             atomic_inc(&counts[1 + lv]);
             marks[m] = (uint2)((uint)p, aa_node_code(lv, at / s, fy / s));
+        }
+}
+
+/* film, slots, trees, split -> marks, counts: the contrast test (aa_contrast_pixel) over the
+ * whole image: in round 0 every pixel, later those whose neighbourhood was split last round
+ * (aa_pixel_dirty). split holds two rounds' blocks, the last round's read and this round's
+ * cleared. */
+__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
+                               __global const int *slots, __global const uchar *levels,
+                               __global const float *values, __global uint2 *marks,
+                               __global uint *counts, __global uint *split)
+{
+    int p = get_global_id(0), npix = aa->width * aa->height;
+    AaTree tree = {levels, values, aa->tree_cap};
+    if (p >= npix) return;
+    /* this round's splits are recorded in the other half of split[] */
+    __global const uint *last = split + (aa->round + 1) % 2 * npix;
+    split[aa->round % 2 * npix + p] = 0u;
+    if (!aa_pixel_dirty(aa, last, p % aa->width, p / aa->width)) return;
+    aa_contrast_pixel(aa, film, slots, tree, marks, counts, last, p);
+}
+
+/* film, slots, trees, split, list -> marks, counts: the contrast test (aa_contrast_pixel) of
+ * the aa->entries pixels listed, those in or next to a pixel split last round
+ * (aa_dirty_list): the other pixels' leaves and their neighbours are as they were when they
+ * last passed. The host clears this round's half of split. */
+__kernel void aa_contrast_list(__constant const VbAaPass *aa, __global const float *film,
+                               __global const int *slots, __global const uchar *levels,
+                               __global const float *values, __global uint2 *marks,
+                               __global uint *counts, __global const uint *split,
+                               __global const uint *list)
+{
+    uint j = get_global_id(0);
+    AaTree tree = {levels, values, aa->tree_cap};
+    if (j >= aa->entries) return;
+    __global const uint *last = split + (aa->round + 1) % 2 * aa->width * aa->height;
+    aa_contrast_pixel(aa, film, slots, tree, marks, counts, last, (int)list[j]);
+}
+
+/* marks, tags -> list, count: the pixels the next round tests, each once: the pixel of each
+ * of the aa->entries marks split in round aa->round and its 8 neighbours. tags[q] holds the
+ * round after the last one whose list q joined (0: none). */
+__kernel void aa_dirty_list(__constant const VbAaPass *aa, __global const uint2 *marks,
+                            __global uint *tags, __global uint *list, __global uint *count)
+{
+    uint j = get_global_id(0);
+    if (j >= aa->entries) return;
+    int p = (int)marks[j].x, x = p % aa->width, y = p / aa->width;
+    uint tag = (uint)aa->round + 1u;
+    for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
+        for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++) {
+            int q = qy * aa->width + qx;
+            if (atomic_xchg(&tags[q], tag) != tag) list[atomic_inc(count)] = (uint)q;
         }
 }
 

@@ -580,8 +580,12 @@ static void two_pixel_fill(float *cells, int lv, float v, const unsigned *odd, u
     }
 }
 
+/* Runs the case's contrast pass in `round` (split last round: pixel 1's blocks `last`,
+ * two rounds ago `older`) over the whole image (aa_contrast_mark), or with `listed` over
+ * the list of both pixels (aa_contrast_list, after the host's clearing of this round's
+ * half of split), and checks the marks. */
 static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsigned last,
-                          unsigned older)
+                          unsigned older, int listed)
 {
     static float tree[2 * VBCL_AA_CELLS * 4], values[2 * AA_TREE_NODES * 4];
     static unsigned char levels[2 * VBCL_AA_CELLS];
@@ -603,16 +607,18 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsign
     pass.round = round;
     pass.tree_cap = 2;
     pass.pairs = tc->first ? SCENE_AA_PAIRS_FIRST : SCENE_AA_PAIRS_BOTH;
+    pass.entries = 2; /* with listed: both pixels */
     /* two rounds' halves: pixel 1's blocks split last round, and two rounds ago (in the
      * half this round clears for its own splits) */
-    cl_uint split[4] = {0};
+    cl_uint split[4] = {0}, list[2] = {0, 1};
     split[(round + 1) % 2 * 2 + 1] = last;
-    split[round % 2 * 2 + 1] = older;
-    cl_mem m[9] = {buffer(&pass, sizeof pass),    buffer(film, sizeof film),
-                   buffer(slots, sizeof slots),   buffer(levels, sizeof levels),
-                   buffer(values, sizeof values), buffer(marks, sizeof marks),
-                   buffer(counts, sizeof counts), buffer(split, sizeof split)};
-    if (run_buffers(fx->r.program, "aa_contrast_mark", 2, m, 8) == 0) {
+    split[round % 2 * 2 + 1] = listed ? 0u : older;
+    cl_mem m[9] = {
+        buffer(&pass, sizeof pass),    buffer(film, sizeof film),     buffer(slots, sizeof slots),
+        buffer(levels, sizeof levels), buffer(values, sizeof values), buffer(marks, sizeof marks),
+        buffer(counts, sizeof counts), buffer(split, sizeof split),   buffer(list, sizeof list)};
+    if (run_buffers(fx->r.program, listed ? "aa_contrast_list" : "aa_contrast_mark", 2, m,
+                    listed ? 9 : 8) == 0) {
         read_buffer(m[5], marks, sizeof marks);
         read_buffer(m[6], counts, sizeof counts);
         int missing = 0;
@@ -623,10 +629,10 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsign
             missing += found != 1;
         }
         CHECK(counts[0] == tc->nwant && missing == 0,
-              "%s, round %d: %u marks, %u expected, %d missing", tc->what, round, counts[0],
-              tc->nwant, missing);
+              "%s, round %d%s: %u marks, %u expected, %d missing", tc->what, round,
+              listed ? " (listed)" : "", counts[0], tc->nwant, missing);
     }
-    for (int i = 0; i < 8; i++) clReleaseMemObject(m[i]);
+    for (int i = 0; i < 9; i++) clReleaseMemObject(m[i]);
 }
 
 #define P0(l, x, y) (0u << 16 | ((l) << 8 | (y) << 4 | (x)))
@@ -811,15 +817,76 @@ static void test_aa_neighbour_rule_across_levels(void)
          1},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        two_pixel_run(&fx, &cases[i], 0, 0u, 0u);
-        two_pixel_run(&fx, &cases[i], 1, 0xffffu, 0u);
-        TwoPixelCase none = cases[i];
-        none.nwant = 0;
-        two_pixel_run(&fx, &none, 2, 0u, 0xffffu);
-        /* split last round only in pixel 1's bottom-right 4 x 4 cells: no leaf of the
-         * cases' marks (all within 8 cells of the border) lies in or next to them */
-        two_pixel_run(&fx, &none, 1, 0x8000u, 0u);
+        two_pixel_run(&fx, &cases[i], 0, 0u, 0u, 0);
+        for (int listed = 0; listed < 2; listed++) { /* the whole image, or both listed */
+            two_pixel_run(&fx, &cases[i], 1, 0xffffu, 0u, listed);
+            TwoPixelCase none = cases[i];
+            none.nwant = 0;
+            two_pixel_run(&fx, &none, 2, 0u, 0xffffu, listed);
+            /* split last round only in pixel 1's bottom-right 4 x 4 cells: no leaf of the
+             * cases' marks (all within 8 cells of the border) lies in or next to them */
+            two_pixel_run(&fx, &none, 1, 0x8000u, 0u, listed);
+        }
     }
+    fixture_close(&fx);
+}
+
+/* The pixels the round after a split tests (aa_dirty_list): on a 5 x 4 image, marks in
+ * round 2 at two corners, an inner pixel, its right neighbour and the inner pixel again (a
+ * second node of it) list each pixel in or next to them once, less one already listed this
+ * round (its tag 3); the same marks again in that round list nothing, and in the next round
+ * all of them again. */
+static void test_aa_dirty_list(void)
+{
+    Fixture fx;
+    if (fixture_open(&fx, "{\"camera\": {\"eye\": [0,0,9], \"look_at\": [0,0,0]}, "
+                          "\"materials\": {\"m\": {\"diffuse\": [1, 1, 1]}}, "
+                          "\"objects\": [{\"shape\": \"box\", \"material\": \"m\"}]}"))
+        return;
+    enum { W = 5, H = 4, N = W * H };
+    const int marked[5] = {0, 1 * W + 2, 3 * W + 4, 1 * W + 3, 1 * W + 2};
+    cl_uint marks[2 * 5], tags[N] = {0}, list[N] = {0}, count = 0;
+    for (int j = 0; j < 5; j++) {
+        marks[2 * j] = (cl_uint)marked[j];
+        marks[2 * j + 1] = aa_node_code(j == 4, 0, 0);
+    }
+    tags[2 * W + 1] = 3; /* listed already in this round */
+    int want[N] = {0}, nwant = 0;
+    for (int j = 0; j < 5; j++)
+        for (int q = 0; q < N; q++)
+            if (abs(q % W - marked[j] % W) <= 1 && abs(q / W - marked[j] / W) <= 1)
+                want[q] = q != 2 * W + 1;
+    for (int q = 0; q < N; q++) nwant += want[q];
+    for (int round = 2; round <= 3; round++)
+        for (int again = 0; again < (round == 2 ? 2 : 1); again++) {
+            VbAaPass pass;
+            memset(&pass, 0, sizeof pass);
+            pass.width = W;
+            pass.height = H;
+            pass.round = round;
+            pass.entries = 5;
+            count = 0;
+            cl_mem m[5] = {buffer(&pass, sizeof pass), buffer(marks, sizeof marks),
+                           buffer(tags, sizeof tags), buffer(list, sizeof list),
+                           buffer(&count, sizeof count)};
+            if (run_buffers(fx.r.program, "aa_dirty_list", 5, m, 5) == 0) {
+                read_buffer(m[2], tags, sizeof tags);
+                read_buffer(m[3], list, sizeof list);
+                read_buffer(m[4], &count, sizeof count);
+                int seen[N] = {0}, bad = 0;
+                for (cl_uint k = 0; k < count && k < N; k++) bad += list[k] >= N || seen[list[k]]++;
+                for (int q = 0; q < N; q++) bad += want[q] && tags[q] != (cl_uint)round + 1;
+                int expect = again ? 0 : round == 2 ? nwant : nwant + 1;
+                int listed_right = 1;
+                for (int q = 0; q < N && !again; q++)
+                    listed_right &= seen[q] == (round == 3 ? want[q] || q == 2 * W + 1 : want[q]);
+                CHECK(count == (cl_uint)expect && bad == 0 && listed_right,
+                      "round %d%s: %u pixels listed, %d expected, %d repeated or untagged, %s",
+                      round, again ? " again" : "", count, expect, bad,
+                      listed_right ? "the right ones" : "not the right ones");
+            }
+            for (int i = 0; i < 5; i++) clReleaseMemObject(m[i]);
+        }
     fixture_close(&fx);
 }
 
@@ -1035,4 +1102,5 @@ void suite_aa(void)
     RUN_TEST(test_aa_samples_nested_never_retraced);
     RUN_TEST(test_aa_neighbour_rule_across_levels);
     RUN_TEST(test_aa_resolve_nearest_samples);
+    RUN_TEST(test_aa_dirty_list);
 }

@@ -47,6 +47,8 @@ typedef struct RenderStats {
     X(bands, "tree_trace_bands", VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)              \
     X(aa_generate, "aa_generate_rays", 0u)                                                         \
     X(aa_contrast, "aa_contrast_mark", 0u)                                                         \
+    X(aa_contrast_list, "aa_contrast_list", 0u)                                                    \
+    X(aa_dirty_list, "aa_dirty_list", 0u)                                                          \
     X(aa_reconstruct, "aa_reconstruct", 0u)                                                        \
     X(aa_split_rays, "aa_split_rays", 0u)                                                          \
     X(aa_split_store, "aa_split_store", 0u)                                                        \

@@ -10,6 +10,7 @@
 
 #include "aa_tree.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -184,21 +185,32 @@ static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, VbAaPass *pas
 }
 
 /* The contrast pass: marks the leaves to split into aa->marks; counts[0] receives how many,
- * counts[1 + l] how many at level l, counts[AA_COUNTS - 1] the tree slots in use. Returns
- * 0 or -1. */
-static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass,
+ * counts[1 + l] how many at level l, counts[AA_COUNTS - 1] the tree slots in use. Tests
+ * every pixel (aa_contrast_mark) when `listed` is AA_ALL, else the `listed` pixels in
+ * aa->list (aa_contrast_list), after clearing this round's half of aa->split. Returns 0
+ * or -1. */
+#define AA_ALL UINT_MAX
+static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned listed,
                    cl_uint counts[AA_COUNTS], RenderStats *st)
 {
     VbDevice *d = r->dev;
+    size_t npix = (size_t)s->width * (size_t)s->height;
     cl_uint zero[AA_COUNTS - 1] = {0};
+    pass->entries = listed;
     if (aa_write_pass(aa, r, pass)) return -1;
     CL_CHECK(
         clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof zero, zero, 0, NULL, NULL),
         fail);
-    const cl_mem args[8] = {aa->pass,   aa->film,  aa->slots,  aa->levels,
-                            aa->values, aa->marks, aa->counts, aa->split};
-    if (aa_launch(r, r->k_aa_contrast, 0, args, 8, (size_t)s->width * (size_t)s->height,
-                  &st->aa_contrast_ms))
+    const cl_mem args[9] = {aa->pass,  aa->film,   aa->slots, aa->levels, aa->values,
+                            aa->marks, aa->counts, aa->split, aa->list};
+    if (listed != AA_ALL)
+        CL_CHECK(clEnqueueFillBuffer(d->queue, aa->split, &zero[0], sizeof zero[0],
+                                     (size_t)(pass->round % 2) * sizeof(cl_uint) * npix,
+                                     sizeof(cl_uint) * npix, 0, NULL, NULL),
+                 fail);
+    if (listed == AA_ALL ? aa_launch(r, r->k_aa_contrast, 0, args, 8, npix, &st->aa_contrast_ms)
+                         : listed && aa_launch(r, r->k_aa_contrast_list, 0, args, 9, listed,
+                                               &st->aa_contrast_ms))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
                                  counts, 0, NULL, NULL),
@@ -257,6 +269,29 @@ static int aa_split(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked, R
         aa_progress(pg, round, level, st->samples, npix, done + k, marked);
     }
     return 0;
+}
+
+/* Lists in aa->list the pixels the round after `pass->round` tests (aa_dirty_list): those
+ * in or next to a pixel of the `marked` nodes in aa->marks, which that round split; *listed
+ * receives how many. Returns 0 or -1. */
+static int aa_list_dirty(AaState *aa, Renderer *r, VbAaPass *pass, unsigned marked,
+                         unsigned *listed, RenderStats *st)
+{
+    cl_uint zero = 0;
+    pass->first = 0;
+    pass->entries = marked;
+    if (aa_write_pass(aa, r, pass)) return -1;
+    CL_CHECK(clEnqueueWriteBuffer(r->dev->queue, aa->list_count, CL_TRUE, 0, sizeof zero, &zero, 0,
+                                  NULL, NULL),
+             fail);
+    const cl_mem args[5] = {aa->pass, aa->marks, aa->tags, aa->list, aa->list_count};
+    if (aa_launch(r, r->k_aa_dirty_list, 0, args, 5, marked, &st->aa_contrast_ms)) return -1;
+    CL_CHECK(clEnqueueReadBuffer(r->dev->queue, aa->list_count, CL_TRUE, 0, sizeof(cl_uint), listed,
+                                 0, NULL, NULL),
+             fail);
+    return 0;
+fail:
+    return -1;
 }
 
 /* Round `level` of the rounds below s->aa_min_level, which split every node of every pixel
@@ -398,6 +433,15 @@ static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba,
     CL_CHECK(clEnqueueFillBuffer(d->queue, aa->info, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
                                  0, NULL, NULL),
              fail);
+    if (!aa->list) { /* adaptive only: the pixels each round tests (aa_list_dirty) */
+        aa->list = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
+        aa->tags = clu_buffer(d, NULL, sizeof(cl_uint) * npix, CL_MEM_READ_WRITE);
+        aa->list_count = clu_buffer(d, NULL, sizeof(cl_uint), CL_MEM_READ_WRITE);
+        if (!aa->list || !aa->tags || !aa->list_count) goto fail;
+    }
+    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->tags, &zero, sizeof zero, 0, sizeof(cl_int) * npix,
+                                 0, NULL, NULL),
+             fail);
     CL_CHECK(clEnqueueWriteBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
                                   NULL),
              fail);
@@ -451,6 +495,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         leaves = npix << (2 * forced);
         slots = (unsigned)npix;
     }
+    unsigned listed = AA_ALL; /* the first tested round tests every pixel */
     for (int round = forced; round < AA_MAX_ROUNDS; round++) {
         cl_uint counts[AA_COUNTS];
         rc = aa_reserve(r, &aa->marks, &aa->mark_cap, leaves, sizeof(cl_uint) * 2, 0, "mark list",
@@ -458,7 +503,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         if (rc) goto out;
         rc = 1;
         pass.round = round;
-        if (aa_mark(aa, r, s, &pass, counts, st)) goto fail;
+        if (aa_mark(aa, r, s, &pass, listed, counts, st)) goto fail;
         if (counts[0] == 0) break;
         st->aa_rounds++;
         /* pixels split for the first time take a tree slot each */
@@ -470,7 +515,8 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         if (rc) goto out;
         rc = 1;
         pg.t_round = clu_now_ms();
-        if (aa_split(aa, r, &pass, counts[0], st, &pg, round, aa_round_level(counts), npix))
+        if (aa_split(aa, r, &pass, counts[0], st, &pg, round, aa_round_level(counts), npix) ||
+            aa_list_dirty(aa, r, &pass, counts[0], &listed, st))
             goto fail;
         slots += counts[1];
         leaves += 3ull * counts[0];
@@ -526,7 +572,8 @@ fail:
 void aa_release(AaState *aa)
 {
     cl_mem *mems[] = {&aa->pass,   &aa->film,   &aa->slots,       &aa->info,  &aa->counts,
-                      &aa->levels, &aa->values, &aa->slot_pixels, &aa->marks, &aa->split};
+                      &aa->levels, &aa->values, &aa->slot_pixels, &aa->marks, &aa->split,
+                      &aa->list,   &aa->tags,   &aa->list_count};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);

@@ -17,7 +17,8 @@
  * nodes and the counters. */
 typedef struct AaState {
     cl_mem pass, film, slots, info, counts;
-    cl_mem split; /* two rounds' split blocks of each pixel (aa_contrast_mark) */
+    cl_mem split;                  /* two rounds' split blocks of each pixel (aa_contrast_mark) */
+    cl_mem list, tags, list_count; /* the pixels a round tests (aa_dirty_list) */
     cl_mem levels, values, slot_pixels; /* tree_cap slots (slot_pixels slot_pixels_cap) */
     cl_mem marks;                       /* mark_cap entries of (pixel, node code) */
     size_t tree_cap, slot_pixels_cap, mark_cap;
