@@ -17,6 +17,7 @@
 #include <string.h>
 
 enum { AA_COUNTS = VBCL_AA_MAX_LEVEL + 2 }; /* marks, marks per level 0..3(4), tree slots */
+#define AA_ALL UINT_MAX                     /* aa_mark: test every pixel, not a list */
 
 /* Creates the buffers every anti-aliasing mode needs (pass, film, slots, info, counts)
  * once. Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
@@ -184,12 +185,25 @@ static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, VbAaPass *pas
     return 0;
 }
 
+/* Clears round `round`'s half of aa->split (two rounds' split blocks per pixel), for the
+ * round's splits to OR into. Returns 0 or -1. */
+static int aa_clear_split(AaState *aa, Renderer *r, int round, size_t npix)
+{
+    cl_uint zero = 0;
+    CL_CHECK(clEnqueueFillBuffer(r->dev->queue, aa->split, &zero, sizeof zero,
+                                 (size_t)(round % 2) * sizeof(cl_uint) * npix,
+                                 sizeof(cl_uint) * npix, 0, NULL, NULL),
+             fail);
+    return 0;
+fail:
+    return -1;
+}
+
 /* The contrast pass: marks the leaves to split into aa->marks; counts[0] receives how many,
  * counts[1 + l] how many at level l, counts[AA_COUNTS - 1] the tree slots in use. Tests
  * every pixel (aa_contrast_mark) when `listed` is AA_ALL, else the `listed` pixels in
- * aa->list (aa_contrast_list), after clearing this round's half of aa->split. Returns 0
- * or -1. */
-#define AA_ALL UINT_MAX
+ * aa->list (at least one; aa_contrast_list), after clearing this round's half of
+ * aa->split. Returns 0 or -1. */
 static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned listed,
                    cl_uint counts[AA_COUNTS], RenderStats *st)
 {
@@ -203,14 +217,10 @@ static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, uns
         fail);
     const cl_mem args[9] = {aa->pass,  aa->film,   aa->slots, aa->levels, aa->values,
                             aa->marks, aa->counts, aa->split, aa->list};
-    if (listed != AA_ALL)
-        CL_CHECK(clEnqueueFillBuffer(d->queue, aa->split, &zero[0], sizeof zero[0],
-                                     (size_t)(pass->round % 2) * sizeof(cl_uint) * npix,
-                                     sizeof(cl_uint) * npix, 0, NULL, NULL),
-                 fail);
-    if (listed == AA_ALL ? aa_launch(r, r->k_aa_contrast, 0, args, 8, npix, &st->aa_contrast_ms)
-                         : listed && aa_launch(r, r->k_aa_contrast_list, 0, args, 9, listed,
-                                               &st->aa_contrast_ms))
+    if (listed == AA_ALL
+            ? aa_launch(r, r->k_aa_contrast, 0, args, 8, npix, &st->aa_contrast_ms)
+            : aa_clear_split(aa, r, pass->round, npix) ||
+                  aa_launch(r, r->k_aa_contrast_list, 0, args, 9, listed, &st->aa_contrast_ms))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
                                  counts, 0, NULL, NULL),
@@ -305,11 +315,7 @@ static int aa_split_all(AaState *aa, Renderer *r, VbAaPass *pass, int level, cl_
     VbDevice *d = r->dev;
     unsigned side = 1u << level, nodes = side * side;
     unsigned long long total = npix * nodes;
-    cl_uint zero = 0;
-    CL_CHECK(clEnqueueFillBuffer(d->queue, aa->split, &zero, sizeof zero,
-                                 (size_t)(level % 2) * sizeof(cl_uint) * npix,
-                                 sizeof(cl_uint) * npix, 0, NULL, NULL),
-             fail);
+    if (aa_clear_split(aa, r, level, (size_t)npix)) return -1;
     pass->round = level;
     for (unsigned long long done = 0; done < total; done += per) {
         unsigned k = total - done < per ? (unsigned)(total - done) : per;
@@ -520,6 +526,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
             goto fail;
         slots += counts[1];
         leaves += 3ull * counts[0];
+        if (listed == 0) break; /* (a split always lists its own pixel) */
     }
     rc = 1;
     if (aa_finish(aa, r, s, &pass, slots, rgba, st)) goto fail;
