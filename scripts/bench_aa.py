@@ -67,10 +67,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 # scene, label, size, extra options
+# glass_bombed_sphere at 128x128, not 64x64, for the reason PATH_MIN_SIZE gives: at 64x64
+# its whole refinement at a threshold is a batch or two, whose fixed costs its few samples
+# carry (docs/benchmarks.md, "glass_bombed_sphere at 128 x 128").
 FULL = [
     ("tests/scenes/aa_edges.json", "aa_edges (flat colours, hard edges)", 128, []),
     ("scenes/quickstart.json", "quickstart (soft shadows)", 128, []),
-    ("scenes/glass_bombed_sphere.json", "glass_bombed_sphere (ray trees)", 64,
+    ("scenes/glass_bombed_sphere.json", "glass_bombed_sphere (ray trees)", 128,
      ["--shadow-samples", "4"]),
     ("scenes/thesis/a4_two_prisms.json", "a4_two_prisms (thesis A.4, --grid auto)", 100,
      ["--grid", "auto"]),
