@@ -4,7 +4,7 @@ uniform (--ssaa N) supersampling, each against a converged --ssaa 16 reference o
 same scene (docs/architecture.md, "Measurements").
 
 usage: scripts/bench_aa.py [--quick] [--vbcl ./vbcl] [--out bench-out] [--repeats N]
-                          [--scenes NAME,...]
+                          [--scenes NAME,...] [--path-only] [--path-size N]
 
 Writes OUT/aa_time_error.csv (one row per render) and OUT/aa_time_error.png (RMSE against
 render time, one panel per scene). Time is the render's wall time from --stats-json (pass 0,
@@ -24,8 +24,9 @@ samples in every pixel) against --ssaa 2^L, in interleaved rounds; device time p
 refinement's tracing batches (aa.refine_ms over the refinement's samples), of all of
 refinement (contrast, tracing, split stores and the nearest-sample resolve), and of uniform
 supersampling (all its kernels), with per-round ratios, on images of at least 128x128
-(PATH_MIN_SIZE). "no shares": the quadtree with --no-sample-shares, whose ray-tree points
-take the feelers uniform's do.
+(PATH_MIN_SIZE; --path-size N renders N x N). "no shares": the quadtree with
+--no-sample-shares, whose ray-tree points take the feelers uniform's do. --path-only runs
+the path cost alone (OUT/aa_path_cost.csv; no time against error), --repeats N rounds.
 --quick renders tiny images (for CI: well under a minute).
 """
 import argparse
@@ -167,7 +168,14 @@ def main():
     ap.add_argument("--repeats", type=int, default=None,
                     help="renders per setting, median time (default 3; --quick 1; "
                          "one for a setting whose first render takes over 3 s)")
+    ap.add_argument("--path-only", action="store_true",
+                    help="only the path cost (OUT/aa_path_cost.csv), not time against error")
+    ap.add_argument("--path-size", type=int, default=0,
+                    help=f"the path cost's image side (default: the scene's, at least "
+                         f"{PATH_MIN_SIZE})")
     a = ap.parse_args()
+    if a.path_size < 0 or (a.repeats is not None and a.repeats < 1):
+        ap.error("--path-size and --repeats take a positive number")
     scenes = QUICK if a.quick else FULL
     if a.scenes:
         scenes = [sc for sc in scenes if os.path.splitext(os.path.basename(sc[0]))[0]
@@ -178,12 +186,15 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for scene, label, size, extra in scenes:
+        for scene, label, size, extra in [] if a.path_only else scenes:
             rows += bench_scene(a, tmp, scene, label, size, extra, thresholds, uniform, repeats)
         path_rows = []
         for scene, label, size, extra in scenes:
             path_rows += path_cost(a, tmp, scene, size, extra, repeats)
     write_csv(os.path.join(a.out, "aa_path_cost.csv"), path_rows)
+    if a.path_only:
+        print(f"bench_aa: wrote {os.path.join(a.out, 'aa_path_cost.csv')}")
+        return
     csv_path = os.path.join(a.out, "aa_time_error.csv")
     write_csv(csv_path, rows, skip=("label",))
     plot(rows, scenes, os.path.join(a.out, "aa_time_error.png"))
@@ -213,7 +224,7 @@ def path_cost(a, tmp, scene, size, extra, repeats):
     """Rows of the path-cost comparison for one scene (module docstring): per level, the
     medians over interleaved rounds (at least 5; one warm-up round first)."""
     name = os.path.splitext(os.path.basename(scene))[0]
-    size = size if a.quick else max(size, PATH_MIN_SIZE)
+    size = a.path_size or (size if a.quick else max(size, PATH_MIN_SIZE))
     npix = size * size
     out = os.path.join(tmp, "path.exr")
     rows = []
