@@ -113,7 +113,8 @@ static const char usage_text[] =
     "environment: VBCL_DEVICE (as --device), VBCL_CACHE_DIR (kernel binary cache;\n"
     "\"off\" disables it; default ~/.cache/vbcl), VBCL_CACHE_MAX_MB (its size, default 256),\n"
     "VBCL_CACHE_BINARIES (1: store binaries on every driver, 0: on none; default: not on\n"
-    "PoCL, which keeps its own kernel cache)\n"
+    "PoCL, which keeps its own kernel cache), VBCL_IMAGE_HELPER (0: load OpenImageIO in\n"
+    "vbcl itself rather than in a helper process that writes the PNG, JPEG, TIFF or EXR)\n"
     "mpirun -np N vbcl SCENE.json ...: the ranks share a still image's tiles, and an\n"
     "animation's frames (frame by frame in tiles with --stats-json); docs/scaling.md\n"
     "exit status: 0 success, 2 bad input or usage, 1 device or render failure\n"
@@ -835,6 +836,7 @@ static int run(Dist *d, int argc, char **argv, double t0)
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
+    if (argc == 2 && strcmp(argv[1], "--image-helper") == 0) return image_helper_main();
     double t0 = clu_now_ms();
     Dist d;
     char err[1024] = "";

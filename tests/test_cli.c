@@ -90,9 +90,28 @@ static void test_cli_help_and_usage(void)
     CHECK(vbcl("scene.json --width 0", out, sizeof out) == 2, "width 0 rejected");
 }
 
+/* The pid of the first LD_DEBUG line of out whose text holds `what`, or -1. vbcl's own is
+ * the first to load libOpenCL (`timeout`, which runs it, loads none). */
+static long ld_debug_pid(const char *out, const char *what)
+{
+    for (const char *l = out; *l; l = strchr(l, '\n') ? strchr(l, '\n') + 1 : l + strlen(l)) {
+        const char *end = strchr(l, '\n');
+        size_t len = end ? (size_t)(end - l) : strlen(l);
+        char line[1024];
+        snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), l);
+        long pid;
+        char colon;
+        if (sscanf(line, " %ld%c", &pid, &colon) == 2 && colon == ':' && strstr(line, what))
+            return pid;
+    }
+    return -1;
+}
+
 /* vbcl loads OpenImageIO only to read or write an image, from the plugin embedded in it
  * (host/util/image_plugin.c): the binary does not link it, --help does not load it, and a
- * render loads it and writes its PNG. */
+ * render has its PNG written by the helper process that loads it (another pid in the
+ * dynamic loader's log), or by itself with VBCL_IMAGE_HELPER=0, the same bytes; the
+ * helper is no option of the command line. */
 static void test_cli_image_plugin(void)
 {
     static char out[1 << 18];
@@ -116,6 +135,26 @@ static void test_cli_image_plugin(void)
              tu_vbcl, scene, img);
     CHECK(tu_run(cmd, out, sizeof out) == 0 && strstr(out, "libOpenImageIO") && file_exists(img),
           "a render loads OpenImageIO and writes %s", img);
+    long main_pid = ld_debug_pid(out, "libOpenCL"), oiio_pid = ld_debug_pid(out, "libOpenImageIO");
+    CHECK(main_pid > 0 && oiio_pid > 0 && oiio_pid != main_pid,
+          "a helper process loads OpenImageIO (pids %ld, %ld)", main_pid, oiio_pid);
+    char here[512];
+    snprintf(here, sizeof here, "%s/plugin_here.png", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             "VBCL_IMAGE_HELPER=0 LD_DEBUG=files timeout 300 %s %s -q -o %s --width 8 --height 8",
+             tu_vbcl, scene, here);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && file_exists(here), "VBCL_IMAGE_HELPER=0 writes %s",
+          here);
+    main_pid = ld_debug_pid(out, "libOpenCL");
+    oiio_pid = ld_debug_pid(out, "libOpenImageIO");
+    CHECK(main_pid > 0 && oiio_pid == main_pid,
+          "VBCL_IMAGE_HELPER=0: vbcl loads OpenImageIO itself (pids %ld, %ld)", main_pid, oiio_pid);
+    snprintf(cmd, sizeof cmd, "cmp %s %s", img, here);
+    CHECK(tu_run(cmd, out, sizeof out) == 0,
+          "the helper's PNG and vbcl's own are the same bytes: %s", out);
+    snprintf(cmd, sizeof cmd, "%s --image-helper", tu_vbcl);
+    CHECK(tu_run(cmd, out, sizeof out) == 2 && strstr(out, "not an option"),
+          "--image-helper on the command line: exit 2, %s", out);
     /* a .pfm vbcl writes itself: a machine without OpenImageIO (a GPU node) still renders */
     snprintf(img, sizeof img, "%s/plugin.pfm", tu_tmpdir());
     snprintf(cmd, sizeof cmd, "LD_DEBUG=files timeout 300 %s %s -q -o %s --width 8 --height 8",

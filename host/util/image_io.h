@@ -23,17 +23,24 @@ int image_is_native_format(const char *path);
 int image_write_pfm(const char *path, int width, int height, const float *rgba, float exposure,
                     char *err, size_t errlen);
 
-/* Starts loading OpenImageIO on a thread of its own, so that the vbcl binary, which loads
- * it as a plugin (image_plugin.c) rather than at start-up, has it by the time it reads or
- * writes an image. Only the vbcl binary has it; programs linked with image_io.cpp have
- * OpenImageIO from the start. */
+/* Makes OpenImageIO ready for the image writes to come while the program goes on: in the
+ * vbcl binary, which loads it as a plugin (image_plugin.c) rather than at start-up, by
+ * starting the helper process that will write the images (`vbcl --image-helper`), or,
+ * where it cannot start, by loading the plugin on a thread of its own. Only the vbcl
+ * binary has it; programs linked with image_io.cpp have OpenImageIO from the start. */
 void image_preload(void);
 
-/* Waits until the load image_preload started has ended (at once if none is under way):
- * vbcl renders only then, since PoCL's first launch of each kernel loads the kernel's code
- * through the same dynamic loader and would wait for OpenImageIO's 260 libraries anyway,
- * inside the render's timing. */
+/* Waits until a load on a thread of this process (image_preload's fallback) has ended (at
+ * once if none is under way): vbcl renders only then, since PoCL's first launch of each
+ * kernel loads the kernel's code through the same dynamic loader and would wait for
+ * OpenImageIO's 260 libraries anyway, inside the render's timing. The helper process
+ * loads them beside the render, in a loader of its own. */
 void image_preload_wait(void);
+
+/* The helper process's main (vbcl --image-helper, started by image_preload): loads the
+ * plugin and writes the images vbcl sends it, until vbcl closes the socket. Returns the
+ * exit status. */
+int image_helper_main(void);
 
 /* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
  * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file

@@ -1,24 +1,38 @@
 /* image_plugin.c — image_write and image_read of the vbcl binary, by OpenImageIO loaded
  * as a plugin. Debian's OpenImageIO brings some 260 shared libraries, whose symbols the
- * dynamic loader resolves in about 0.2 s (docs/benchmarks.md, "What every render pays
+ * dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render pays
  * before its first ray"); linked into vbcl, every run paid that before main, `--help`
  * included. Instead image_io.cpp is built into a shared object embedded in the binary
- * (vbcl_image_plugin, Makefile). image_preload loads it on a thread of its own while the
- * program builds its kernels and renders, and the first image_write or image_read waits
- * for it. main starts it once the devices are open: the dynamic loader loads one library
- * at a time, so starting earlier would hold up the OpenCL driver's own loading. The
- * binary stays one file: the plugin is loaded from an anonymous memory file
- * (memfd_create), or from an unlinked temporary file where there is none. */
+ * (vbcl_image_plugin, Makefile), loaded from an anonymous memory file (memfd_create), or
+ * from an unlinked temporary file where there is none, so that the binary stays one file.
+ *
+ * A render that writes such an image has it written by a helper process: image_preload
+ * starts vbcl again as `vbcl --image-helper` (image_helper_main), which loads the plugin
+ * while this process builds its kernels and renders, and image_write sends it the pixels.
+ * Loaded on a thread of this process instead, the plugin held up the kernels' build from
+ * source for as long as it loaded (the dynamic loader serves one thread at a time:
+ * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
+ * start, with VBCL_IMAGE_HELPER=0, and for image_read (textures, before any device is
+ * open), the plugin loads here, on a thread of its own (image_preload) or at the first
+ * call. */
 #include "image_io.h"
 
 #include <dlfcn.h>
 #include <errno.h>
 #include <pthread.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+extern char **environ;
 
 /* The plugin's bytes (image_plugin_blob.o, which the Makefile makes). */
 extern const unsigned char vbcl_image_plugin[], vbcl_image_plugin_end[];
@@ -104,7 +118,8 @@ static void *plugin_thread(void *arg)
     return NULL;
 }
 
-void image_preload(void)
+/* The plugin loaded on a thread of this process (the helper's fallback). */
+static void preload_thread(void)
 {
     pthread_mutex_lock(&plugin_lock);
     if (plugin.state == PLUGIN_NONE) {
@@ -115,6 +130,155 @@ void image_preload(void)
         }
     }
     pthread_mutex_unlock(&plugin_lock);
+}
+
+/* The helper process: its pid and this end of the socket to it (-1: none). */
+#define HELPER_FD    63 /* the socket's descriptor in the helper */
+#define HELPER_MAGIC 0x76626931u
+static pthread_mutex_t helper_lock = PTHREAD_MUTEX_INITIALIZER;
+static struct {
+    pid_t pid;
+    int fd;
+} helper = {0, -1};
+
+/* A write request: the header, then path_len bytes of path, then width * height * 4 floats.
+ * The reply: rc (0 or -1), then err_len bytes of message. */
+typedef struct {
+    uint32_t magic;
+    int32_t width, height;
+    float exposure;
+    uint32_t path_len;
+} HelperRequest;
+typedef struct {
+    int32_t rc;
+    uint32_t err_len;
+} HelperReply;
+
+/* Sends or receives all n bytes; 0, or -1 on an error or the other end gone. */
+static int sock_all(int fd, void *buf, size_t n, int sending)
+{
+    char *p = buf;
+    while (n > 0) {
+        ssize_t k = sending ? send(fd, p, n, MSG_NOSIGNAL) : recv(fd, p, n, 0);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+/* Ends the helper: closing the socket tells it to exit; then it is reaped. */
+static void helper_stop(void)
+{
+    pthread_mutex_lock(&helper_lock);
+    if (helper.fd >= 0) {
+        close(helper.fd);
+        helper.fd = -1;
+        while (waitpid(helper.pid, NULL, 0) < 0 && errno == EINTR) {
+        }
+    }
+    pthread_mutex_unlock(&helper_lock);
+}
+
+/* Starts `vbcl --image-helper` with one end of a socket pair as its HELPER_FD; 0, or -1
+ * when it cannot (no /proc/self/exe, no process, VBCL_IMAGE_HELPER=0). */
+static int helper_start(void)
+{
+    const char *env = getenv("VBCL_IMAGE_HELPER");
+    if (env && !strcmp(env, "0")) return -1;
+    int sv[2];
+    if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv)) return -1;
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_adddup2(&fa, sv[1], HELPER_FD); /* the copy keeps no CLOEXEC */
+    char arg0[] = "vbcl", arg1[] = "--image-helper";
+    char *argv[] = {arg0, arg1, NULL};
+    pid_t pid;
+    int rc = posix_spawn(&pid, "/proc/self/exe", &fa, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    close(sv[1]);
+    if (rc) {
+        close(sv[0]);
+        return -1;
+    }
+    helper.pid = pid;
+    helper.fd = sv[0];
+    atexit(helper_stop);
+    return 0;
+}
+
+void image_preload(void)
+{
+    pthread_mutex_lock(&helper_lock);
+    int started = helper.fd >= 0 || helper_start() == 0;
+    pthread_mutex_unlock(&helper_lock);
+    if (!started) preload_thread();
+}
+
+/* image_write through the helper: 0, -1 with its message, or -2 when there is no helper
+ * or it is gone (then the caller writes here). */
+static int helper_write(const char *path, int width, int height, const float *rgba, float exposure,
+                        char *err, size_t errlen)
+{
+    pthread_mutex_lock(&helper_lock);
+    int rc = -2;
+    size_t plen = strlen(path), bytes = sizeof(float) * 4 * (size_t)width * (size_t)height;
+    HelperRequest q = {HELPER_MAGIC, width, height, exposure, (uint32_t)plen};
+    HelperReply a;
+    if (helper.fd >= 0 && !sock_all(helper.fd, &q, sizeof q, 1) &&
+        !sock_all(helper.fd, (void *)path, plen, 1) &&
+        !sock_all(helper.fd, (void *)rgba, bytes, 1) && !sock_all(helper.fd, &a, sizeof a, 0) &&
+        a.err_len < 4096) {
+        char msg[4096];
+        if (!sock_all(helper.fd, msg, a.err_len, 0)) {
+            msg[a.err_len] = 0;
+            if (a.rc) snprintf(err, errlen, "%s", msg);
+            rc = a.rc ? -1 : 0;
+        }
+    }
+    pthread_mutex_unlock(&helper_lock);
+    if (rc == -2) helper_stop(); /* gone: not asked again */
+    return rc;
+}
+
+/* `vbcl --image-helper`: loads the plugin, then writes each image the socket on
+ * HELPER_FD asks for and answers with image_write's result, until the socket closes.
+ * A request cut short (vbcl gone) writes nothing. */
+int image_helper_main(void)
+{
+    HelperRequest q;
+    struct stat st;
+    if (fstat(HELPER_FD, &st) || !S_ISSOCK(st.st_mode)) {
+        fprintf(stderr, "vbcl: --image-helper is vbcl's own helper, not an option\n");
+        return 2;
+    }
+    plugin_load();
+    while (!sock_all(HELPER_FD, &q, sizeof q, 0)) {
+        if (q.magic != HELPER_MAGIC || q.width <= 0 || q.height <= 0 || q.path_len == 0 ||
+            q.path_len > 4095 || (size_t)q.width > SIZE_MAX / 16 / (size_t)q.height)
+            return 1;
+        char path[4096], err[1024] = "";
+        size_t bytes = sizeof(float) * 4 * (size_t)q.width * (size_t)q.height;
+        float *rgba = malloc(bytes);
+        if (!rgba || sock_all(HELPER_FD, path, q.path_len, 0) ||
+            sock_all(HELPER_FD, rgba, bytes, 0)) {
+            free(rgba);
+            return 1;
+        }
+        path[q.path_len] = 0;
+        int rc = -1;
+        if (plugin.write)
+            rc = plugin.write(path, q.width, q.height, rgba, q.exposure, err, sizeof err);
+        else
+            snprintf(err, sizeof err, "%s: cannot load vbcl's OpenImageIO plugin: %s", path,
+                     plugin.err);
+        free(rgba);
+        HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u};
+        if (sock_all(HELPER_FD, &a, sizeof a, 1) || sock_all(HELPER_FD, err, a.err_len, 1))
+            return 1;
+    }
+    return 0;
 }
 
 void image_preload_wait(void)
@@ -147,6 +311,13 @@ int image_write(const char *path, int width, int height, const float *rgba, floa
     if (image_check_path(path, err, errlen)) return -1;
     if (image_is_native_format(path))
         return image_write_pfm(path, width, height, rgba, exposure, err, errlen);
+    pthread_mutex_lock(&plugin_lock);
+    int here = plugin.state != PLUGIN_NONE; /* loaded, or loading, in this process */
+    pthread_mutex_unlock(&plugin_lock);
+    if (!here) {
+        int rc = helper_write(path, width, height, rgba, exposure, err, errlen);
+        if (rc != -2) return rc;
+    }
     if (plugin_ready(path, err, errlen)) return -1;
     return plugin.write(path, width, height, rgba, exposure, err, errlen);
 }
