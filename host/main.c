@@ -813,14 +813,16 @@ static int run(Dist *d, int argc, char **argv, double t0)
     int have_still = !rc && first < 0; /* still is ours to render or free */
     VbDevice devs[CLU_MAX_DEVICES];
     int ndev = 0;
+    int writes = !rc && (d->rank == 0 || first >= 0) /* the ranks that write images */
+                 && needs_image_library(&o, have_still ? &still : NULL);
+    if (writes) image_preload(0); /* the helper process, at once: a loader of its own */
     if (!rc) {
         const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
         rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
         if (rc)
             diag_print(prog, "%s", err);
-        else if ((d->rank == 0 || first >= 0) /* the ranks that write images */
-                 && needs_image_library(&o, have_still ? &still : NULL))
-            image_preload();    /* OpenImageIO loads while the kernels are built and run */
+        else if (writes)
+            image_preload(1);   /* without a helper, OpenImageIO loads on a thread from here */
         rc = dist_agree(d, rc); /* every rank has its devices, or all stop */
     }
     if (!rc) {

@@ -25,10 +25,12 @@ int image_write_pfm(const char *path, int width, int height, const float *rgba, 
 
 /* Makes OpenImageIO ready for the image writes to come while the program goes on: in the
  * vbcl binary, which loads it as a plugin (image_plugin.c) rather than at start-up, by
- * starting the helper process that will write the images (`vbcl --image-helper`), or,
- * where it cannot start, by loading the plugin on a thread of its own. Only the vbcl
+ * starting the helper process that will write the images (`vbcl --image-helper`; once a
+ * run), or, where it cannot start and `thread` is set, by loading the plugin on a thread
+ * of its own (vbcl asks for that once its devices are open: the dynamic loader serves one
+ * thread at a time, and the OpenCL driver's own loading would wait for it). Only the vbcl
  * binary has it; programs linked with image_io.cpp have OpenImageIO from the start. */
-void image_preload(void);
+void image_preload(int thread);
 
 /* Waits until a load on a thread of this process (image_preload's fallback) has ended (at
  * once if none is under way): vbcl renders only then, since PoCL's first launch of each

@@ -8,7 +8,8 @@
  *
  * A render that writes such an image has it written by a helper process: image_preload
  * starts vbcl again as `vbcl --image-helper` (image_helper_main), which loads the plugin
- * while this process builds its kernels and renders, and image_write sends it the pixels.
+ * while this process opens its devices, builds its kernels and renders, and image_write
+ * sends it the pixels.
  * Loaded on a thread of this process instead, the plugin held up the kernels' build from
  * source for as long as it loaded (the dynamic loader serves one thread at a time:
  * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
@@ -139,7 +140,8 @@ static pthread_mutex_t helper_lock = PTHREAD_MUTEX_INITIALIZER;
 static struct {
     pid_t pid;
     int fd;
-} helper = {0, -1};
+    int tried; /* helper_start was called: one helper a run */
+} helper = {0, -1, 0};
 
 /* A write request: the header, then path_len bytes of path, then width * height * 4 floats.
  * The reply: rc (0 or -1), then err_len bytes of message. */
@@ -208,12 +210,13 @@ static int helper_start(void)
     return 0;
 }
 
-void image_preload(void)
+void image_preload(int thread)
 {
     pthread_mutex_lock(&helper_lock);
-    int started = helper.fd >= 0 || helper_start() == 0;
+    int started = helper.fd >= 0 || (!helper.tried && helper_start() == 0);
+    helper.tried = 1;
     pthread_mutex_unlock(&helper_lock);
-    if (!started) preload_thread();
+    if (!started && thread) preload_thread();
 }
 
 /* image_write through the helper: 0, -1 with its message, or -2 when there is no helper
