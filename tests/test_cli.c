@@ -94,15 +94,15 @@ static void test_cli_help_and_usage(void)
  * the first to load libOpenCL (`timeout`, which runs it, loads none). */
 static long ld_debug_pid(const char *out, const char *what)
 {
-    for (const char *l = out; *l; l = strchr(l, '\n') ? strchr(l, '\n') + 1 : l + strlen(l)) {
-        const char *end = strchr(l, '\n');
-        size_t len = end ? (size_t)(end - l) : strlen(l);
+    for (const char *l = out; *l;) {
+        const char *end = l + strcspn(l, "\n");
         char line[1024];
-        snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), l);
+        snprintf(line, sizeof line, "%.*s", (int)(end - l < 1023 ? end - l : 1023), l);
         long pid;
         char colon;
         if (sscanf(line, " %ld%c", &pid, &colon) == 2 && colon == ':' && strstr(line, what))
             return pid;
+        l = *end ? end + 1 : end;
     }
     return -1;
 }

@@ -107,6 +107,13 @@ static void plugin_load(void)
     }
 }
 
+/* Why the plugin is not there, for an image at path, in err; returns -1. */
+static int plugin_missing(const char *path, char *err, size_t errlen)
+{
+    snprintf(err, errlen, "%s: cannot load vbcl's OpenImageIO plugin: %s", path, plugin.err);
+    return -1;
+}
+
 /* The preload thread (detached): loads the plugin and wakes whoever waits for it. */
 static void *plugin_thread(void *arg)
 {
@@ -270,12 +277,9 @@ int image_helper_main(void)
             return 1;
         }
         path[q.path_len] = 0;
-        int rc = -1;
-        if (plugin.write)
-            rc = plugin.write(path, q.width, q.height, rgba, q.exposure, err, sizeof err);
-        else
-            snprintf(err, sizeof err, "%s: cannot load vbcl's OpenImageIO plugin: %s", path,
-                     plugin.err);
+        int rc = plugin.write
+                     ? plugin.write(path, q.width, q.height, rgba, q.exposure, err, sizeof err)
+                     : plugin_missing(path, err, sizeof err);
         free(rgba);
         HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u};
         if (sock_all(HELPER_FD, &a, sizeof a, 1) || sock_all(HELPER_FD, err, a.err_len, 1))
@@ -303,9 +307,7 @@ static int plugin_ready(const char *path, char *err, size_t errlen)
     while (plugin.state != PLUGIN_DONE) pthread_cond_wait(&plugin_loaded, &plugin_lock);
     int ok = plugin.write != NULL;
     pthread_mutex_unlock(&plugin_lock);
-    if (!ok)
-        snprintf(err, errlen, "%s: cannot load vbcl's OpenImageIO plugin: %s", path, plugin.err);
-    return ok ? 0 : -1;
+    return ok ? 0 : plugin_missing(path, err, errlen);
 }
 
 int image_write(const char *path, int width, int height, const float *rgba, float exposure,
