@@ -26,19 +26,19 @@ static double per(unsigned long long a, unsigned long long b)
 /* ---- the --stats text ---- */
 
 /* How the program came (RenderStats.build_cached: CLU_BUILT, CLU_BINARY,
- * CLU_BUILT_DRIVER_CACHE), as --stats says it and as --stats-json's program.from. */
+ * CLU_BUILT_DRIVER_CACHE, CLU_KEPT), as --stats says it and as --stats-json's program.from. */
 static const struct BuildSource {
     const char *text, *json;
 } build_sources[] = {
-    [CLU_BUILT] = {"cold: built from source", "source"},
-    [CLU_BINARY] = {"warm: cached binary", "binary"},
-    [CLU_BUILT_DRIVER_CACHE] = {"built from source through the driver's kernel cache",
-                                "source_driver_cache"},
+    [CLU_BUILT] = {"compiled from source: no earlier build of it in vbcl's cache", "source"},
+    [CLU_BINARY] = {"loaded from vbcl's binary cache", "binary"},
+    [CLU_BUILT_DRIVER_CACHE] = {"built through the driver's kernel cache", "source_driver_cache"},
+    [CLU_KEPT] = {"kept from an earlier frame", "kept"},
 };
 
 static const struct BuildSource *build_source(int how)
 {
-    return &build_sources[how == CLU_BINARY || how == CLU_BUILT_DRIVER_CACHE ? how : CLU_BUILT];
+    return &build_sources[how >= CLU_BUILT && how <= CLU_KEPT ? how : CLU_BUILT];
 }
 
 /* scene, device, features, program, grid */
@@ -54,8 +54,9 @@ static void print_setup(FILE *f, const StatsFrame *fr)
             s->nobjects, s->mesh.ntris, s->nmaterials, s->nlights);
     fprintf(f, "device      %s (%s)\n", fr->dev->name, fr->dev->version);
     fprintf(f, "features    %s\n", feat);
-    fprintf(f, "program     %.1f ms (%s), options: %s\n", st->build_ms,
-            build_source(st->build_cached)->text, st->options);
+    fprintf(f, "program     %s, %.1f ms (%s; first launches %.1f ms), options: %s\n",
+            features_program_name(st->program), st->build_ms, build_source(st->build_cached)->text,
+            st->first_launch_ms, st->options);
     fprintf(f,
             "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max "
             "%u, empty %.1f%%, per non-empty cell %.2f, refined %d times\n",
@@ -261,7 +262,9 @@ static void json_setup(cJSON *root, const StatsFrame *fr, int *ok)
     for (char *save = NULL, *w = strtok_r(feat, " ", &save); a && w; w = strtok_r(NULL, " ", &save))
         if (strcmp(w, "none")) push(a, cJSON_CreateString(w), ok);
     o = obj(root, "program", ok);
+    str(o, "name", features_program_name(st->program), ok);
     num(o, "build_ms", st->build_ms, ok);
+    num(o, "first_launch_ms", st->first_launch_ms, ok);
     flag(o, "cached", st->build_cached == CLU_BINARY, ok);
     str(o, "from", build_source(st->build_cached)->json, ok);
     str(o, "options", st->options, ok);

@@ -31,8 +31,10 @@
  * and every counter update becomes a store and a reload. */
 #ifdef __clang__
 #define VB_INLINE inline __attribute__((always_inline))
+#define VB_CALLED __attribute__((noinline))
 #else
 #define VB_INLINE inline
+#define VB_CALLED
 #endif
 
 /* float3 from three floats of a host-written array (the shared structs hold float[3]). */

@@ -531,27 +531,4 @@ VB_INLINE uint grid_box_leaf(const GridBoxRange *r, uint k)
     return r->first + (uint)(x + r->n.x * (y + r->n.y * z));
 }
 
-#ifdef VBCL_TEST_KERNELS
-/* For the tests: per query (a top cell and a box: cell xyz in q[0..2] as floats, box
- * corners in q[4..6] and q[8..10], 12 floats a query) marks in mark[query * ntris + tri]
- * every triangle of the leaves grid_cell_box_range gives. */
-__kernel void probe_grid_box_range(__constant const VbFrame *f, __global const VbGridCell *cells,
-                                   __global const uint *leaf_start,
-                                   __global const VbLeafQuad *leaf_quads, __global const float *q,
-                                   uint nq, uint ntris, __global uchar *mark)
-{
-    uint i = get_global_id(0);
-    if (i >= nq) return;
-    __global const float *p = q + 12 * i;
-    int3 cell = convert_int3((float3)(p[0], p[1], p[2]));
-    GridBoxRange r = grid_cell_box_range(&f->grid, cells, cell, vload3(0, p + 4), vload3(0, p + 8));
-    for (uint k = 0; k < r.count; k++) {
-        uint leaf = grid_box_leaf(&r, k);
-        for (uint j = leaf_start[leaf]; j < leaf_start[leaf + 1]; j++)
-            for (int l = 0; l < 4; l++)
-                if (leaf_quads[j].tri[l] >= 0) mark[(size_t)i * ntris + leaf_quads[j].tri[l]] = 1;
-    }
-}
-#endif
-
 #endif

@@ -45,7 +45,9 @@ typedef struct ShadePoint {
 
 /* What a shadow feeler from sp lets through toward a light at distance t: 0 or 1, or,
  * with transparent objects, the transmittance of the interfaces and media it crosses; only
- * the objects of os can stop it (os->n < 0: any object, through the grid). */
+ * the objects of os can stop it (os->n < 0: any object, through the grid). A program with
+ * transparency takes the second way for every scene (it is exact for opaque ones too), so
+ * that it holds one copy of each walk. */
 VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, const ObjectSet *os,
                               float3 origin, float3 w, float t, TraceCount *tc)
 {
@@ -53,15 +55,11 @@ VB_INLINE float3 light_feeler(const DevScene *sc, const ShadePoint *sp, const Ob
     return medium_shadow_transmittance(sc, os, origin, w, t, sp->medium, sp->band, tc);
 #else
     (void)sp;
-#ifdef VBCL_HAS_TEXTURES
     /* Without transparency every host and element is opaque: a texture surface that a
      * feeler from outside meets before its host's surface lies outside the host, where the
      * texture does not exist, and one inside a host lies behind the host's opaque surface.
      * So texture triangles never stop a feeler here. */
-    const uint skip = VBCL_TAG_TEXTURE;
-#else
-    const uint skip = 0u;
-#endif
+    const uint skip = (sc->f->flags & VBCL_FRAME_TEXTURES) ? VBCL_TAG_TEXTURE : 0u;
     return scene_trace_any_in(sc, os, origin, w, t, skip, tc) ? (float3)(0.0f) : (float3)(1.0f);
 #endif
 }

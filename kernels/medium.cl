@@ -82,7 +82,7 @@ typedef struct PathHit {
  * to the first interface within tmax, among the triangles of os (os->n < 0: any, through
  * the grid; a set holds for every stretch of the ray). Returns 0 when there is none.
  * camera: a camera ray, whose first search is camera_trace_closest. */
-VB_INLINE int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+VB_CALLED int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
                            float tmax, VbMedium *state, PathHit *out, TraceCount *tc, uint *passes,
                            int camera)
 {
@@ -133,24 +133,26 @@ VB_INLINE float medium_band_transmit(const DevScene *sc, uint m, int band)
 VB_INLINE float3 medium_interface_transmit(const DevScene *sc, float3 d, float3 ng, uint mb,
                                            uint ma, int band)
 {
+    int thesis = (sc->f->flags & VBCL_FRAME_FRESNEL_THESIS) != 0u;
 #ifdef VBCL_HAS_DISPERSION
     if (band >= 0)
         return (float3)(optics_transmitted_fraction(d, ng, medium_eta(sc, mb, band),
-                                                    medium_eta(sc, ma, band)) *
+                                                    medium_eta(sc, ma, band), thesis) *
                         medium_band_transmit(sc, ma, band));
     if (sc->materials[mb].disp >= 0 || sc->materials[ma].disp >= 0) {
         float3 t = (float3)(0.0f);
         for (int b = 0; b < sc->f->bands; b++)
             t += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) *
-                 (optics_transmitted_fraction(d, ng, medium_eta(sc, mb, b), medium_eta(sc, ma, b)) *
+                 (optics_transmitted_fraction(d, ng, medium_eta(sc, mb, b), medium_eta(sc, ma, b),
+                                              thesis) *
                   medium_band_transmit(sc, ma, b));
         return t;
     }
 #else
     (void)band;
 #endif
-    return (
-        float3)(optics_transmitted_fraction(d, ng, sc->materials[mb].eta, sc->materials[ma].eta));
+    return (float3)(optics_transmitted_fraction(d, ng, sc->materials[mb].eta, sc->materials[ma].eta,
+                                                thesis));
 }
 
 /* Light a shadow feeler of band `band` (-1: white) carries from the point to a light at

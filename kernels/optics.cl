@@ -59,7 +59,8 @@ typedef struct OpticsSplit {
 /* Splits d at a surface with shading normal ns and geometric normal ng (both facing the
  * incoming ray). The shading normal gives the directions unless it would send a ray to
  * the wrong side of the surface; the geometric one is used then. */
-VB_INLINE OpticsSplit optics_split(float3 d, float3 ns, float3 ng, float eta1, float eta2)
+VB_INLINE OpticsSplit optics_split(float3 d, float3 ns, float3 ng, float eta1, float eta2,
+                                   int thesis)
 {
     OpticsSplit s;
     float3 n = ns;
@@ -78,29 +79,25 @@ VB_INLINE OpticsSplit optics_split(float3 d, float3 ns, float3 ng, float eta1, f
         s.T = 0.0f;
         return s;
     }
-#ifdef VBCL_HAS_FRESNEL_THESIS
-    /* thesis eq. 9: angle-independent, |eta2 - eta1| / (eta2 + eta1) */
-    s.R = fabs(eta2 - eta1) / (eta2 + eta1);
-    s.T = 1.0f - s.R;
-#else
-    s.R = optics_fresnel_reflect(eta1, eta2, ci, cos_t);
-    s.T = optics_fresnel_transmit(eta1, eta2, ci, cos_t);
-#endif
+    if (thesis) { /* thesis eq. 9: angle-independent, |eta2 - eta1| / (eta2 + eta1) */
+        s.R = fabs(eta2 - eta1) / (eta2 + eta1);
+        s.T = 1.0f - s.R;
+    } else {
+        s.R = optics_fresnel_reflect(eta1, eta2, ci, cos_t);
+        s.T = optics_fresnel_transmit(eta1, eta2, ci, cos_t);
+    }
     return s;
 }
 
 /* Fraction of light a shadow feeler keeps through an interface (feelers are not bent). */
-VB_INLINE float optics_transmitted_fraction(float3 d, float3 ng, float eta1, float eta2)
+VB_INLINE float optics_transmitted_fraction(float3 d, float3 ng, float eta1, float eta2, int thesis)
 {
     float3 t;
     float cos_t;
     float ci = fabs(dot(d, ng));
     if (!optics_refract(d, ng, eta1 / eta2, &t, &cos_t) || ci < 1e-7f) return 0.0f;
-#ifdef VBCL_HAS_FRESNEL_THESIS
-    return 1.0f - fabs(eta2 - eta1) / (eta2 + eta1);
-#else
-    return optics_fresnel_transmit(eta1, eta2, ci, cos_t);
-#endif
+    return thesis ? 1.0f - fabs(eta2 - eta1) / (eta2 + eta1)
+                  : optics_fresnel_transmit(eta1, eta2, ci, cos_t);
 }
 
 #endif

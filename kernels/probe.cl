@@ -1,12 +1,34 @@
 #line 2 "probe.cl"
-/* probe.cl — kernels for the tests and the ray-throughput bench only (built with
- * -DVBCL_TEST_KERNELS, never in a render): brute-force closest hit, the layout of the shared
- * structs as the device sees it, local shading at arbitrary points for analytic checks, and
- * the renderer's tracing and shading on rays the bench picks (tests/bench/bench_rays.c). */
+/* probe.cl — kernels for the tests and the ray-throughput bench only, a program of their
+ * own (the test binaries embed it; vbcl does not, so it is in no render's source or cache
+ * key): brute-force closest hit, the layout of the shared structs as the device sees it,
+ * local shading at arbitrary points for analytic checks, the grid's box ranges, and the
+ * renderer's tracing and shading on rays the bench picks (tests/bench/bench_rays.c). */
 #ifndef VBCL_PROBE_CL
 #define VBCL_PROBE_CL
 
 #include "render.cl"
+
+/* For the tests: per query (a top cell and a box: cell xyz in q[0..2] as floats, box
+ * corners in q[4..6] and q[8..10], 12 floats a query) marks in mark[query * ntris + tri]
+ * every triangle of the leaves grid_cell_box_range gives. */
+__kernel void probe_grid_box_range(__constant const VbFrame *f, __global const VbGridCell *cells,
+                                   __global const uint *leaf_start,
+                                   __global const VbLeafQuad *leaf_quads, __global const float *q,
+                                   uint nq, uint ntris, __global uchar *mark)
+{
+    uint i = get_global_id(0);
+    if (i >= nq) return;
+    __global const float *p = q + 12 * i;
+    int3 cell = convert_int3((float3)(p[0], p[1], p[2]));
+    GridBoxRange r = grid_cell_box_range(&f->grid, cells, cell, vload3(0, p + 4), vload3(0, p + 8));
+    for (uint k = 0; k < r.count; k++) {
+        uint leaf = grid_box_leaf(&r, k);
+        for (uint j = leaf_start[leaf]; j < leaf_start[leaf + 1]; j++)
+            for (int l = 0; l < 4; l++)
+                if (leaf_quads[j].tri[l] >= 0) mark[(size_t)i * ntris + leaf_quads[j].tri[l]] = 1;
+    }
+}
 
 /* rays -> hits by testing every triangle: the reference for the grid. */
 __kernel void probe_intersect_brute(__global const VbTriangle *tris, uint ntris,
@@ -79,14 +101,15 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
 }
 
 /* cases (dir xyz, eta1; normal xyz, eta2) -> (reflected xyz, R; transmitted xyz, T;
- * tir, 0, 0, 0): the interface optics on their own, normal facing the ray. */
-__kernel void probe_optics(__global const float *in, int n, __global float *out)
+ * tir, 0, 0, 0): the interface optics on their own, normal facing the ray; thesis 1: the
+ * energy split of the thesis's eq. 9. */
+__kernel void probe_optics(__global const float *in, int n, __global float *out, int thesis)
 {
     int i = get_global_id(0);
     if (i >= n) return;
     float3 d = vload3(0, in + 8 * i), nrm = vload3(0, in + 8 * i + 4);
     float eta1 = in[8 * i + 3], eta2 = in[8 * i + 7];
-    OpticsSplit s = optics_split(d, nrm, nrm, eta1, eta2);
+    OpticsSplit s = optics_split(d, nrm, nrm, eta1, eta2, thesis);
     vstore4((float4)(s.reflected, s.R), 0, out + 12 * i);
     vstore4((float4)(s.transmitted, s.T), 0, out + 12 * i + 4);
     vstore4((float4)((float)s.tir, 0.0f, 0.0f, 0.0f), 0, out + 12 * i + 8);

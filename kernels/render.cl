@@ -1,24 +1,20 @@
 #line 2 "render.cl"
-/* render.cl — the kernel entry points of a frame, run tile by tile:
+/* render.cl — the tracing program's entry points, run tile by tile:
  *   camera_generate_rays    frame              -> rays
  *   aa_generate_rays        frame              -> rays (--ssaa: supersamples of pixels)
+ *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
  *   scene_intersect_closest rays               -> hits, media (first interface of each ray)
  *   light_sample_shading    rays, hits, media  -> radiance (k_local term, shadow feelers)
  *   tree_trace_secondary    rays, hits, media  -> radiance += (k_global term: the ray tree;
  *                                                 only with VBCL_HAS_TRANSPARENCY), splits
  *   tree_trace_bands        splits             -> radiance += the recorded dispersive
  *                                                 subtrees (only with VBCL_HAS_DISPERSION)
- *   aa_reconstruct          radiance           -> film (--ssaa: box window per pixel)
- *   aa_contrast_mark        film, trees        -> marks (quadtree leaves to split)
- *   aa_contrast_list        film, trees, list  -> marks (the same, for listed pixels)
- *   aa_dirty_list           marks              -> list (the pixels the next round tests)
- *   aa_split_rays           frame, marks       -> rays (the new samples of split nodes)
- *   aa_split_store          radiance, marks    -> trees (four leaves for each split node)
- *   aa_resolve              trees, slots       -> film, info (each pixel from its samples)
- * The frame's entry points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays
- * adds the pass, aa_split_rays the pass and the list, with dispersion the tree kernels add
- * the split records, the other aa_* kernels take only their own buffers), are
- * thin — index, bounds guard, device functions — and the host concatenates these files. */
+ * The anti-aliasing kernels that trace nothing are film.cl's program. The frame's entry
+ * points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays adds the pass,
+ * aa_split_rays the pass and the list, with dispersion the tree kernels add the split
+ * records), are thin — index, bounds guard, device functions — and the host concatenates
+ * these files. A program has the code of the VBCL_HAS_* it is compiled with and tests the
+ * scene's VBCL_FRAME_* flags where it has more (host/device/kernel_features.c). */
 
 #ifndef VBCL_RENDER_CL
 #define VBCL_RENDER_CL
@@ -30,8 +26,10 @@
 #include "tree.cl"
 
 #if defined(VBCL_HAS_TRANSPARENCY) || defined(VBCL_HAS_TEXTURES)
-#define VBCL_HAS_MEDIA 1 /* rays track the medium they are in */
+#define VBCL_HAS_MEDIA 1 /* rays can track the medium they are in */
 #endif
+/* Whether the scene's rays track their medium: it has transparent surfaces or textures. */
+#define FRAME_MEDIA(f) (((f)->flags & (VBCL_FRAME_TRANSPARENCY | VBCL_FRAME_TEXTURES)) != 0u)
 
 /* The arguments every frame kernel takes: the scene's, then the ray batch's. */
 #define FRAME_KERNEL_ARGS                                                                          \
@@ -73,12 +71,14 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     sp.ns = sp.ng;
     sp.wo = -dir;
 #ifdef VBCL_HAS_SMOOTH_NORMALS
-    __global const VbTriNormals *tn = sc->normals + h.tri;
-    float3 ns = w0 * vb_gload3(tn->n0) + h.u * vb_gload3(tn->n1) + h.v * vb_gload3(tn->n2);
-    float len = length(ns);
-    if (len > 0.0f) {
-        ns = ns * (side / len);
-        if (dot(ns, sp.wo) > 0.0f) sp.ns = ns;
+    if (sc->f->flags & VBCL_FRAME_SMOOTH_NORMALS) {
+        __global const VbTriNormals *tn = sc->normals + h.tri;
+        float3 ns = w0 * vb_gload3(tn->n0) + h.u * vb_gload3(tn->n1) + h.v * vb_gload3(tn->n2);
+        float len = length(ns);
+        if (len > 0.0f) {
+            ns = ns * (side / len);
+            if (dot(ns, sp.wo) > 0.0f) sp.ns = ns;
+        }
     }
 #else
     (void)w0;
@@ -137,20 +137,21 @@ __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
     VbRay r = rays[i];
     TraceCount tc = {0, 0};
 #ifdef VBCL_HAS_MEDIA
-    VbMedium state = f->camera_medium;
-    PathHit ph;
-    uint passes = 0;
-    VbHit miss = {r.tmax, -1, 0.0f, 0.0f};
-    ObjectSet all = object_set_all();
-    hits[i] = medium_trace(&sc, &all, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph, &tc,
-                           &passes, 1)
-                  ? ph.hit
-                  : miss;
-    media[i] = state;
-    if (passes) atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], passes);
-#else
-    hits[i] = camera_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
+    if (FRAME_MEDIA(f)) {
+        VbMedium state = f->camera_medium;
+        PathHit ph;
+        uint passes = 0;
+        VbHit miss = {r.tmax, -1, 0.0f, 0.0f};
+        ObjectSet all = object_set_all();
+        hits[i] = medium_trace(&sc, &all, vb_load3(r.org), vb_load3(r.dir), r.tmax, &state, &ph,
+                               &tc, &passes, 1)
+                      ? ph.hit
+                      : miss;
+        media[i] = state;
+        if (passes) atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], passes);
+    } else
 #endif
+        hits[i] = camera_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
     atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc.steps);
     atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
 }
@@ -180,25 +181,27 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
     VbRay r = rays[i];
     float3 dir = vb_load3(r.dir);
     float3 col;
-#ifdef VBCL_HAS_MEDIA
-    VbMedium before = media[i];
-#else
     VbMedium before = {-1, 0u};
+#ifdef VBCL_HAS_MEDIA
+    const int tracked = FRAME_MEDIA(f);
+    if (tracked) before = media[i];
 #endif
     if (h.tri < 0) {
         col = vb_cload3(f->background);
 #ifdef VBCL_HAS_MEDIA
-        col *= medium_absorb(&sc, medium_material(&sc, before), INFINITY);
+        if (tracked) col *= medium_absorb(&sc, medium_material(&sc, before), INFINITY);
 #endif
     } else {
         float3 weight = (float3)(1.0f);
+        uint material;
 #ifdef VBCL_HAS_MEDIA
-        Crossing c = medium_cross(&sc, h.tri, dir, before);
-        uint material = c.surface;
-        weight = medium_absorb(&sc, c.mat_before, h.t);
-#else
-        uint material = scene_tri_material(&sc, h.tri);
+        if (tracked) {
+            Crossing c = medium_cross(&sc, h.tri, dir, before);
+            material = c.surface;
+            weight = medium_absorb(&sc, c.mat_before, h.t);
+        } else
 #endif
+            material = scene_tri_material(&sc, h.tri);
         ShadePoint sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, material);
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0, 0, 0, 0, 0};
@@ -275,9 +278,11 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     int i = get_global_id(0);
     if (i >= nrays) return;
 #ifdef VBCL_HAS_DISPERSION
-    __global VbSplitSet *rec = splits + i;
-    rec->count = 0;
-    rec->budget = 0.0f;
+    __global VbSplitSet *rec = (f->flags & VBCL_FRAME_DISPERSION) ? splits + i : 0;
+    if (rec) {
+        rec->count = 0;
+        rec->budget = 0.0f;
+    }
 #else
     __global VbSplitSet *rec = 0;
 #endif
@@ -302,7 +307,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
     float3 acc = tree_run(&sc, stack, n, sample_share(f, r.sample), &cnt, &tc, &shc, rec);
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
 #ifdef VBCL_HAS_DISPERSION
-    rec->budget = cnt.prune_budget;
+    if (rec) rec->budget = cnt.prune_budget;
 #endif
     tree_flush_counts(counters, &cnt, &tc, &shc);
 }
@@ -365,111 +370,6 @@ __kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa)
     rays[i] = camera_ray(f, px, py, aa_sample_id(pixel, aa->side, sub));
 }
 
-/* radiance -> film: uniform supersampling, each pixel of a batch the mean of its side^2
- * samples (a box window over its own subpixels, thesis figure 4.4). */
-__kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float *radiance,
-                             __global float *film)
-{
-    uint j = get_global_id(0);
-    if (j >= aa->entries) return;
-    uint n = (uint)(aa->side * aa->side);
-    float4 sum = (float4)(0.0f);
-    for (uint k = 0; k < n; k++) sum += vload4(j * n + k, radiance);
-    vstore4(sum * (1.0f / (float)n), aa->first + j, film);
-}
-
-/* The contrast test of pixel p (x, y) in a round (aa_contrast_mark, aa_contrast_list): an
- * unsplit pixel against its neighbours, or each leaf of a split one below the top level
- * against its adjacent leaves (aa_leaf_fails), after round 0 only the leaves that lie in or
- * next to a block split last round (aa_leaf_touched; last: the last round's half of split).
- * A failing leaf is appended to marks as (pixel, node code); counts[0] counts the marks,
- * counts[1 + l] those at level l. */
-VB_INLINE void aa_contrast_pixel(__constant const VbAaPass *aa, __global const float *film,
-                                 __global const int *slots, AaTree tree, __global uint2 *marks,
-                                 __global uint *counts, __global const uint *last, int p)
-{
-    int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
-    if (slot < 0) {
-        float3 a = aa_display(aa, vload4(p, film).xyz);
-        int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
-        if (all_plain ? !fails
-                      : !aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE, y * AA_TREE_SIDE,
-                                       AA_TREE_SIDE, 0, a))
-            return;
-        uint m = atomic_inc(&counts[0]);
-        atomic_inc(&counts[1]);
-        marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
-        return;
-    }
-    __global const uchar *own = tree.levels + (size_t)slot * VBCL_AA_CELLS;
-    for (int fy = 0; fy < AA_TREE_SIDE; fy++) /* each row one leaf at a time */
-        for (int fx = 0; fx < AA_TREE_SIDE;) {
-            int lv = own[fy * AA_TREE_SIDE + fx], s = AA_TREE_SIDE >> lv, at = fx;
-            fx += s;
-            if (lv >= aa->max_level || fy % s) continue; /* not the leaf's first row */
-            int X0 = x * AA_TREE_SIDE + at, Y0 = y * AA_TREE_SIDE + fy;
-            if (aa->round > 0 && !aa_leaf_touched(aa, last, X0, Y0, s)) continue;
-            float3 c = vload4(aa_cell_value(tree.cap, slot, lv, at, fy), tree.values).xyz;
-            if (!aa_leaf_fails(aa, film, slots, tree, X0, Y0, s, lv, aa_display(aa, c))) continue;
-            uint m = atomic_inc(&counts[0]);
-            atomic_inc(&counts[1 + lv]);
-            marks[m] = (uint2)((uint)p, aa_node_code(lv, at / s, fy / s));
-        }
-}
-
-/* film, slots, trees, split -> marks, counts: the contrast test (aa_contrast_pixel) over the
- * whole image: in round 0 every pixel, later those whose neighbourhood was split last round
- * (aa_pixel_dirty). split holds two rounds' blocks, the last round's read and this round's
- * cleared. */
-__kernel void aa_contrast_mark(__constant const VbAaPass *aa, __global const float *film,
-                               __global const int *slots, __global const uchar *levels,
-                               __global const float *values, __global uint2 *marks,
-                               __global uint *counts, __global uint *split)
-{
-    int p = get_global_id(0), npix = aa->width * aa->height;
-    AaTree tree = {levels, values, aa->tree_cap};
-    if (p >= npix) return;
-    /* this round's splits are recorded in the other half of split[] */
-    __global const uint *last = split + (aa->round + 1) % 2 * npix;
-    split[aa->round % 2 * npix + p] = 0u;
-    if (!aa_pixel_dirty(aa, last, p % aa->width, p / aa->width)) return;
-    aa_contrast_pixel(aa, film, slots, tree, marks, counts, last, p);
-}
-
-/* film, slots, trees, split, list -> marks, counts: the contrast test (aa_contrast_pixel) of
- * the aa->entries pixels listed, those in or next to a pixel split last round
- * (aa_dirty_list): the other pixels' leaves and their neighbours are as they were when they
- * last passed. The host clears this round's half of split. */
-__kernel void aa_contrast_list(__constant const VbAaPass *aa, __global const float *film,
-                               __global const int *slots, __global const uchar *levels,
-                               __global const float *values, __global uint2 *marks,
-                               __global uint *counts, __global const uint *split,
-                               __global const uint *list)
-{
-    uint j = get_global_id(0);
-    AaTree tree = {levels, values, aa->tree_cap};
-    if (j >= aa->entries) return;
-    __global const uint *last = split + (aa->round + 1) % 2 * aa->width * aa->height;
-    aa_contrast_pixel(aa, film, slots, tree, marks, counts, last, (int)list[j]);
-}
-
-/* marks, tags -> list, count: the pixels the next round tests, each once: the pixel of each
- * of the aa->entries marks split in round aa->round and its 8 neighbours. tags[q] holds the
- * round after the last one whose list q joined (0: none). */
-__kernel void aa_dirty_list(__constant const VbAaPass *aa, __global const uint2 *marks,
-                            __global uint *tags, __global uint *list, __global uint *count)
-{
-    uint j = get_global_id(0);
-    if (j >= aa->entries) return;
-    int p = (int)marks[j].x, x = p % aa->width, y = p / aa->width;
-    uint tag = (uint)aa->round + 1u;
-    for (int qy = max(y - 1, 0); qy <= min(y + 1, aa->height - 1); qy++)
-        for (int qx = max(x - 1, 0); qx <= min(x + 1, aa->width - 1); qx++) {
-            int q = qy * aa->width + qx;
-            if (atomic_xchg(&tags[q], tag) != tag) list[atomic_inc(count)] = (uint)q;
-        }
-}
-
 /* frame, marks -> rays: three rays per marked node of a batch, through the samples of the
  * three children that do not hold the node's own sample (aa_tree.h): ray i belongs to
  * mark first + i / 3. */
@@ -486,95 +386,5 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,
                          aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
 }
-
-/* radiance, marks -> levels, values, slots, slot_pixels, split: each marked node of a
- * batch becomes four leaves one level deeper: the child holding the node's sample keeps its
- * value, the other three take the new samples. A pixel split for the first time gets a tree
- * slot (counts[VBCL_AA_MAX_LEVEL + 1] counts the slots; the host made room for them); each
- * split node's blocks (aa_node_blocks) are ORed into its pixel's mask in this round's half
- * of split. */
-__kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2 *marks,
-                             __global const float *radiance, __global const float *film,
-                             __global int *slots, __global int *slot_pixels, __global uchar *levels,
-                             __global float *values, __global uint *counts, __global uint *split)
-{
-    uint j = get_global_id(0);
-    if (j >= aa->entries) return;
-    uint2 m = marks[aa->first + j];
-    int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
-    atomic_or(&split[aa->round % 2 * aa->width * aa->height + (int)m.x], aa_node_blocks(m.y));
-    if (slot < 0) {
-        slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
-        slots[m.x] = slot;
-        slot_pixels[slot] = (int)m.x;
-    }
-    uint cap = aa->tree_cap;
-    int keep = aa_kept_index(m.y);
-    float4 v =
-        lv == 1 ? vload4(m.x, film)
-                : vload4(aa_node_value(cap, slot, lv - 1, aa_node_x(m.y), aa_node_y(m.y)), values);
-    aa_fill_levels(levels + (size_t)slot * VBCL_AA_CELLS, m.y, lv);
-    for (int c = 0; c < 4; c++) { /* the kept child the node's value, the others (in
-                                   * aa_new_child's order) the new samples */
-        uint child = aa_child(m.y, c);
-        float4 cv = c == keep ? v : vload4(3 * j + (uint)(c < keep ? c : c - 1), radiance);
-        vstore4((float4)(cv.xyz, 0.0f),
-                aa_node_value(cap, slot, lv, aa_node_x(child), aa_node_y(child)), values);
-    }
-}
-
-/* levels, values, slot_pixels, slots -> film, info: each refined pixel becomes the mean of
- * its finest cells (a box window over the pixel's own footprint, figure 4.4), each cell the
- * value of the sample nearest to it among the pixel's own and its refined neighbours' near
- * it (aa_nearest_weights; from[s] is the tree slot of the pixel at source s) or, with
- * aa->reconstruct 1, of the leaf covering it (the area-weighted mean of the leaves, the
- * thesis's); info its deepest level | leaf count << 8. */
-__kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot_pixels,
-                         __global const uchar *levels, __global const float *values,
-                         __global float *film, __global int *info, __global const int *slots)
-{
-    uint slot = get_global_id(0);
-    if (slot >= aa->entries) return;
-    __global const uchar *own = levels + (size_t)slot * VBCL_AA_CELLS;
-    uint leaf[AA_EXT_MAX];
-    float w[AA_EXT_MAX];
-    uint cap = aa->tree_cap;
-    int p = slot_pixels[slot];
-    int deepest = 0, nown = aa_leaf_list(own, leaf, &deepest);
-    float3 sum = (float3)(0.0f);
-    if (aa->reconstruct == 1) { /* each cell the value of the leaf covering it */
-        for (int k = 0; k < VBCL_AA_CELLS; k++)
-            sum += vload4(aa_cell_value(cap, (int)slot, own[k], k % AA_TREE_SIDE, k / AA_TREE_SIDE),
-                          values)
-                       .xyz;
-    } else {
-        int x = p % aa->width, y = p / aa->width, n = nown, from[9];
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
-                int q = (y + dy) * aa->width + x + dx, src = (dy + 1) * 3 + dx + 1;
-                from[src] = (int)slot;
-                if (src == (int)AA_OWN || x + dx < 0 || x + dx >= aa->width || y + dy < 0 ||
-                    y + dy >= aa->height || slots[q] < 0)
-                    continue;
-                from[src] = slots[q];
-                n = aa_band_list(levels + (size_t)slots[q] * VBCL_AA_CELLS, dx, dy, leaf, n);
-            }
-        aa_nearest_weights(leaf, n, nown, w);
-        for (int i = 0; i < n; i++)
-            if (w[i] > 0.0f) {
-                int at = (int)(leaf[i] >> 16 & 255u), lv = (int)(leaf[i] >> 24 & 15u);
-                sum += w[i] * vload4(aa_cell_value(cap, from[leaf[i] >> 28], lv, at % AA_TREE_SIDE,
-                                                   at / AA_TREE_SIDE),
-                                     values)
-                                  .xyz;
-            }
-    }
-    vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
-    info[p] = deepest | nown << 8;
-}
-
-#ifdef VBCL_TEST_KERNELS
-#include "probe.cl"
-#endif
 
 #endif

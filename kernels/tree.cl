@@ -11,14 +11,17 @@
 #include "medium.cl"
 #include "optics.cl"
 
-/* Depth-first with at most one pending sibling per level: max_depth + 1 entries suffice.
- * The host compiles the stack for the next size class (8, 16, 32, 64) above the scene's
- * max_depth, so changing the depth rarely rebuilds the program. With dispersion the level
- * of a path's one split holds up to `bands` pending band rays: max_depth + 1 + bands. */
+/* Depth-first with at most one pending sibling per level: max_depth + 1 entries suffice,
+ * and with dispersion the level of a path's one split holds up to `bands` pending band rays
+ * more. The host compiles the stack for the deepest tree any scene can ask of the program
+ * (kernel_features.c: 65 entries, 129 with dispersion), so no scene setting rebuilds it. */
 #ifndef VBCL_TREE_STACK
-#define VBCL_TREE_STACK 8
+#define VBCL_TREE_STACK 65
 #endif
 #define VB_TREE_STACK VBCL_TREE_STACK
+
+/* Whether the scene splits energy by the thesis's eq. 9 instead of Fresnel's equations. */
+#define TREE_THESIS(sc) (((sc)->f->flags & VBCL_FRAME_FRESNEL_THESIS) != 0u)
 
 /* A pending branch of the tree. */
 typedef struct TreeRay {
@@ -88,7 +91,7 @@ VB_INLINE void tree_push_bands(const DevScene *sc, TreeRay *stack, int *n, const
     for (int b = 0; b < sc->f->bands; b++) {
         float3 bw = vb_gload3(sc->texels + sc->f->band_weights + 4 * b);
         OpticsSplit s = optics_split(dir, sp->ns, sp->ng, medium_eta(sc, c->mat_before, b),
-                                     medium_eta(sc, c->mat_after, b));
+                                     medium_eta(sc, c->mat_after, b), TREE_THESIS(sc));
         cnt->tir += (uint)s.tir;
         cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
         if (s.T > 0.0f)
@@ -135,14 +138,14 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
     if (band < 0 &&
         (sc->materials[c->mat_before].disp >= 0 || sc->materials[c->mat_after].disp >= 0)) {
         OpticsSplit s0 = optics_split(dir, sp->ns, sp->ng, sc->materials[c->mat_before].eta,
-                                      sc->materials[c->mat_after].eta);
+                                      sc->materials[c->mat_after].eta, TREE_THESIS(sc));
         cnt->interfaces++;
         if (s0.T > 0.0f) { /* a refraction: split into the bands */
             cnt->splits++;
             float3 wr = (float3)(0.0f);
             for (int b = 0; b < sc->f->bands; b++) {
                 OpticsSplit s = optics_split(dir, sp->ns, sp->ng, medium_eta(sc, c->mat_before, b),
-                                             medium_eta(sc, c->mat_after, b));
+                                             medium_eta(sc, c->mat_after, b), TREE_THESIS(sc));
                 wr += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) * s.R;
             }
             tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s0.reflected,
@@ -164,7 +167,7 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
     float eta1 = sc->materials[c->mat_before].eta, eta2 = sc->materials[c->mat_after].eta;
     float tin = 1.0f;
 #endif
-    OpticsSplit s = optics_split(dir, sp->ns, sp->ng, eta1, eta2);
+    OpticsSplit s = optics_split(dir, sp->ns, sp->ng, eta1, eta2, TREE_THESIS(sc));
     cnt->tir += (uint)s.tir;
     cnt->interfaces++;
     cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;

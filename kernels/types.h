@@ -339,7 +339,14 @@ typedef struct VbFrame {
 #define VBCL_FRAME_SAMPLE_SHARES                                                                   \
     16u /* adaptive anti-aliasing with feelers by weight: a quadtree sample's id carries its       \
          * level, and its points count 2^-level of their weight (sample_share) */
-#define VBCL_CONE_TEST_MAX_OBJECTS 64 /* scenes with more objects trace every feeler */
+/* What the scene uses, for programs compiled with more than it needs (kernel_features.c):
+ * each of these is tested at run time wherever the program has the code for it. */
+#define VBCL_FRAME_FRESNEL_THESIS  32u  /* the thesis's angle-independent split (eq. 9) */
+#define VBCL_FRAME_SMOOTH_NORMALS  64u  /* the mesh has vertex normals (the normals buffer) */
+#define VBCL_FRAME_TRANSPARENCY    128u /* some surface has k_global > 0: rays cross media */
+#define VBCL_FRAME_TEXTURES        256u /* some object holds a volume texture */
+#define VBCL_FRAME_DISPERSION      512u /* some transparent material disperses: split records */
+#define VBCL_CONE_TEST_MAX_OBJECTS 64   /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
 

@@ -453,9 +453,9 @@ def part_build(a, out):
             "kernel cache, POCL_CACHE_DIR, emptied too), then again with the caches the first "
             "run filled (warm: clCreateProgramWithBinary from vbcl's cache, or on PoCL, where "
             "vbcl stores no binary, clBuildProgram served by PoCL's kernel cache). "
-            "first_render_ms: the render's wall time, which on PoCL includes compiling each "
-            "kernel's work-group function at its first launch; process_s: the whole command "
-            "(texture generation comes from its own cache in both).")
+            "build_ms includes each kernel's first launch on no work, where PoCL compiles its "
+            "work-group function; first_render_ms: the render's wall time; process_s: the "
+            "whole command (texture generation comes from its own cache in both).")
     return write_table(out, "build_time", rows,
                        ["features", "run", "cold_build_ms", "cold_first_render_ms",
                         "cold_process_s", "warm_build_ms", "warm_first_render_ms",

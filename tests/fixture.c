@@ -25,7 +25,7 @@ int fixture_open(Fixture *fx, const char *json)
     }
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (renderer_init(&fx->r, d, &fx->s, "-DVBCL_TEST_KERNELS", &st, err, sizeof err)) {
+    if (renderer_init(&fx->r, d, &fx->s, vbcl_probe_source, &st, err, sizeof err)) {
         CHECK(0, "renderer_init: %s", err);
         scene_free(&fx->s);
         return -1;
@@ -45,6 +45,14 @@ void fixture_close(Fixture *fx)
     if (fx->ok) renderer_release(&fx->r);
     if (fx->ok) scene_free(&fx->s);
     fx->ok = 0;
+}
+
+/* The work-group size of the tests' launches: the renderer's (64), so that a driver that
+ * compiles a kernel for each work-group size (PoCL) compiles each kernel once. */
+static const size_t *tu_local(size_t global)
+{
+    static const size_t local = 64;
+    return tu_device()->max_wg >= local && global % local == 0 ? &local : NULL;
 }
 
 cl_mem buffer(const void *data, size_t bytes)
@@ -71,7 +79,7 @@ int run_kernel(cl_program prog, const char *name, size_t n, int nargs, const siz
         CHECK(rc == CL_SUCCESS, "%s argument %d: %s", name, i, clu_error_name(rc));
     }
     size_t global = (n + 63) / 64 * 64;
-    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);
+    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, tu_local(global), 0, NULL, NULL);
     CHECK(rc == CL_SUCCESS, "enqueue %s: %s", name, clu_error_name(rc));
     clFinish(d->queue);
     clReleaseKernel(k);
@@ -97,7 +105,7 @@ void fixture_run_frame_kernel(Fixture *fx, const char *name, cl_mem rays, int n,
     CHECK(renderer_set_frame_args(&fx->r, k, rays, n, hits, media, radiance, counters) == 0,
           "frame arguments: %s", clu_error());
     size_t global = ((size_t)n + 63) / 64 * 64;
-    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);
+    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, tu_local(global), 0, NULL, NULL);
     CHECK(rc == CL_SUCCESS, "enqueue %s: %s", name, clu_error_name(rc));
     clFinish(d->queue);
     clReleaseMemObject(media);
@@ -110,7 +118,7 @@ int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const 
 {
     VbDevice *d = tu_device();
     cl_int rc;
-    cl_kernel k = clCreateKernel(fx->r.program, name, &rc);
+    cl_kernel k = clCreateKernel(fx->r.probe, name, &rc);
     CHECK(rc == CL_SUCCESS, "clCreateKernel(%s): %s", name, clu_error_name(rc));
     if (rc != CL_SUCCESS) return -1;
     CHECK(scene_buffers_set_args(&fx->r.buf, k) == 0, "scene arguments: %s", clu_error());
@@ -120,7 +128,7 @@ int fixture_run_probe(Fixture *fx, const char *name, size_t n, int nargs, const 
               clu_error_name(rc));
     }
     size_t global = (n + 63) / 64 * 64;
-    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL);
+    rc = clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, tu_local(global), 0, NULL, NULL);
     CHECK(rc == CL_SUCCESS, "enqueue %s: %s", name, clu_error_name(rc));
     clFinish(d->queue);
     clReleaseKernel(k);

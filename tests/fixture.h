@@ -5,7 +5,8 @@
 
 #include "render.h"
 
-/* A scene loaded from JSON text and prepared on the test device (-DVBCL_TEST_KERNELS). */
+/* A scene loaded from JSON text and prepared on the test device, with the probe program
+ * (kernels/probe.cl) built beside the renderer's (r.probe). */
 typedef struct Fixture {
     Scene s;
     Renderer r;

@@ -617,7 +617,7 @@ static void two_pixel_run(Fixture *fx, const TwoPixelCase *tc, int round, unsign
         buffer(&pass, sizeof pass),    buffer(film, sizeof film),     buffer(slots, sizeof slots),
         buffer(levels, sizeof levels), buffer(values, sizeof values), buffer(marks, sizeof marks),
         buffer(counts, sizeof counts), buffer(split, sizeof split),   buffer(list, sizeof list)};
-    if (run_buffers(fx->r.program, listed ? "aa_contrast_list" : "aa_contrast_mark", 2, m,
+    if (run_buffers(fx->r.film, listed ? "aa_contrast_list" : "aa_contrast_mark", 2, m,
                     listed ? 9 : 8) == 0) {
         read_buffer(m[5], marks, sizeof marks);
         read_buffer(m[6], counts, sizeof counts);
@@ -869,7 +869,7 @@ static void test_aa_dirty_list(void)
             cl_mem m[5] = {buffer(&pass, sizeof pass), buffer(marks, sizeof marks),
                            buffer(tags, sizeof tags), buffer(list, sizeof list),
                            buffer(&count, sizeof count)};
-            if (run_buffers(fx.r.program, "aa_dirty_list", 5, m, 5) == 0) {
+            if (run_buffers(fx.r.film, "aa_dirty_list", 5, m, 5) == 0) {
                 read_buffer(m[2], tags, sizeof tags);
                 read_buffer(m[3], list, sizeof list);
                 read_buffer(m[4], &count, sizeof count);
@@ -1032,7 +1032,7 @@ static void test_aa_resolve_nearest_samples(void)
                        buffer(levels, sizeof levels), buffer(values, sizeof values),
                        buffer(film, sizeof film),     buffer(info, sizeof info),
                        buffer(slots, sizeof slots)};
-        if (run_buffers(fx.r.program, "aa_resolve", TREES, m, 7) == 0) {
+        if (run_buffers(fx.r.film, "aa_resolve", TREES, m, 7) == 0) {
             read_buffer(m[4], film, sizeof film);
             read_buffer(m[5], info, sizeof info);
             int bad = 0, bad_info = 0, differs = 0;

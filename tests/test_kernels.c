@@ -30,7 +30,7 @@ static void trace_grid_and_brute(Fixture *fx, const VbRay *rays, int n, VbHit *h
     const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
                          sizeof(cl_mem)};
     const void *v[] = {&fx->r.buf.tris, &ntris, &mr, &n, &mb};
-    run_kernel(fx->r.program, "probe_intersect_brute", (size_t)n, 5, sz, v);
+    run_kernel(fx->r.probe, "probe_intersect_brute", (size_t)n, 5, sz, v);
     read_buffer(mg, hg, sizeof *hg * (size_t)n);
     read_buffer(mb, hb, sizeof *hb * (size_t)n);
     clReleaseMemObject(mr);
@@ -52,7 +52,7 @@ static void test_kernel_struct_layout(void)
     cl_mem m = buffer(NULL, sizeof out);
     const size_t sz[] = {sizeof(cl_mem)};
     const void *v[] = {&m};
-    run_kernel(fx.r.program, "probe_layout", 1, 1, sz, v);
+    run_kernel(fx.r.probe, "probe_layout", 1, 1, sz, v);
     read_buffer(m, out, sizeof out);
 #define HOST_LAYOUT_ITEM(e) (cl_uint)(e),
     const cl_uint want[N] = {VBCL_LAYOUT_ITEMS(HOST_LAYOUT_ITEM)};
@@ -291,7 +291,7 @@ static void compare_camera_tiles(const char *label, const char *json, int n, int
     const size_t sz[] = {sizeof(cl_mem), sizeof(cl_uint), sizeof(cl_mem), sizeof(int),
                          sizeof(cl_mem)};
     const void *v[] = {&fx.r.buf.tris, &ntris, &mr, &nb, &mb};
-    run_kernel(fx.r.program, "probe_intersect_brute", (size_t)nb, 5, sz, v);
+    run_kernel(fx.r.probe, "probe_intersect_brute", (size_t)nb, 5, sz, v);
     read_buffer(mb, hb, sizeof *hb * (size_t)nb);
     int hits = 0, differ = 0, bad = 0, ties = 0;
     for (int i = 0; i < n; i++) {
@@ -428,7 +428,7 @@ static void test_grid_cell_box_range(void)
     const void *v[] = {
         &mf, &fx.r.buf.grid_cells, &fx.r.buf.leaf_start, &fx.r.buf.leaf_quads, &mq, &nq, &ntris,
         &mm};
-    run_kernel(fx.r.program, "probe_grid_box_range", NQ, 8, sz, v);
+    run_kernel(fx.r.probe, "probe_grid_box_range", NQ, 8, sz, v);
     read_buffer(mm, mark, (size_t)NQ * ntris);
     int missing = 0, foreign = 0, restricted = 0, crowded = 0;
     for (int i = 0; i < NQ; i++) {
@@ -1008,7 +1008,7 @@ static int cap_uv(Fixture *fx, unsigned strata, unsigned nkeys, int mode, float 
     const size_t sz[] = {sizeof(unsigned), sizeof(unsigned), sizeof(unsigned), sizeof(int),
                          sizeof(cl_mem)};
     const void *v[] = {&strata, &key0, &nkeys, &mode, &mo};
-    int rc = run_kernel(fx->r.program, "probe_cap_uv", nkeys, 5, sz, v);
+    int rc = run_kernel(fx->r.probe, "probe_cap_uv", nkeys, 5, sz, v);
     read_buffer(mo, uv, sizeof(float) * 2 * n);
     clReleaseMemObject(mo);
     return rc;
@@ -1229,7 +1229,7 @@ static void test_light_lobe_cap(void)
     int n = N;
     const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
     const void *args[] = {&mc, &n, &mo};
-    int rc = run_kernel(fx.r.program, "probe_lobe_cap", N, 3, sz, args);
+    int rc = run_kernel(fx.r.probe, "probe_lobe_cap", N, 3, sz, args);
     read_buffer(mo, out, sizeof out);
     clReleaseMemObject(mc);
     clReleaseMemObject(mo);

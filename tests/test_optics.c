@@ -29,9 +29,10 @@ static int run_optics(const char *mode, const float *in, int n, float *out)
     if (fixture_open(&fx, json)) return -1;
     cl_mem mi = buffer(in, sizeof(float) * CASE_IN * (size_t)n);
     cl_mem mo = buffer(NULL, sizeof(float) * CASE_OUT * (size_t)n);
-    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *v[] = {&mi, &n, &mo};
-    int rc = run_kernel(fx.r.program, "probe_optics", (size_t)n, 3, sz, v);
+    int thesis = strcmp(mode, "thesis") == 0;
+    const size_t sz[] = {sizeof(cl_mem), sizeof(int), sizeof(cl_mem), sizeof(int)};
+    const void *v[] = {&mi, &n, &mo, &thesis};
+    int rc = run_kernel(fx.r.probe, "probe_optics", (size_t)n, 4, sz, v);
     read_buffer(mo, out, sizeof(float) * CASE_OUT * (size_t)n);
     clReleaseMemObject(mi);
     clReleaseMemObject(mo);

@@ -161,7 +161,9 @@ static int tracer_trace(Tracer *tr, const VbRay *rays, int n, VbHit *hits, int b
             rc = CL_INVALID_KERNEL_ARGS;
     }
     size_t global = ((size_t)n + 63) / 64 * 64;
-    if (rc == CL_SUCCESS) rc = clEnqueueNDRangeKernel(q, k, 1, NULL, &global, NULL, 0, NULL, NULL);
+    if (rc == CL_SUCCESS)
+        rc = clEnqueueNDRangeKernel(q, k, 1, NULL, &global, renderer_local(&tr->r, global), 0, NULL,
+                                    NULL);
     if (rc == CL_SUCCESS)
         rc = clEnqueueReadBuffer(q, tr->hits, CL_TRUE, 0, sizeof *hits * (size_t)n, hits, 0, NULL,
                                  NULL);
@@ -192,14 +194,14 @@ static int tracer_open(Tracer *tr, VbDevice *d, const Scene *s, char *err, size_
     tr->d = d;
     RenderStats st;
     memset(&st, 0, sizeof st);
-    if (renderer_init(&tr->r, d, s, "-DVBCL_TEST_KERNELS", &st, err, errlen)) {
+    if (renderer_init(&tr->r, d, s, vbcl_probe_source, &st, err, errlen)) {
         memset(&tr->r, 0, sizeof tr->r);
         return -1;
     }
     cl_int rc = clEnqueueWriteBuffer(d->queue, tr->r.buf.frame, CL_TRUE, 0, sizeof(VbFrame),
                                      &tr->r.frame_host, 0, NULL, NULL);
     cl_int rc2, rc3, rc4, rc5;
-    tr->brute = clCreateKernel(tr->r.program, "probe_intersect_brute", &rc2);
+    tr->brute = clCreateKernel(tr->r.probe, "probe_intersect_brute", &rc2);
     tr->rays = clCreateBuffer(d->context, CL_MEM_READ_ONLY, sizeof(VbRay) * 2 * WT_AIMED * WT_BATCH,
                               NULL, &rc3);
     tr->hits = clCreateBuffer(d->context, CL_MEM_WRITE_ONLY,

@@ -355,6 +355,8 @@ void clu_devices_close(VbDevice *devs, int n)
 
 void clu_device_close(VbDevice *d)
 {
+    for (int i = 0; i < d->nkept; i++) CL_WARN(clReleaseProgram(d->kept[i].program));
+    d->nkept = 0;
     if (d->queue) CL_WARN(clReleaseCommandQueue(d->queue));
     if (d->context) CL_WARN(clReleaseContext(d->context));
     d->queue = NULL;
@@ -381,19 +383,60 @@ static unsigned char *read_all(const char *path, size_t *len)
     return buf;
 }
 
-/* Stores the program's binary under path, written whole (temporary file + rename). */
+/* A cached binary: this header, then the driver's bytes. The length and the hash of the
+ * bytes let a truncated or damaged file be told from a good one before the driver sees it
+ * (a driver may crash on a damaged binary instead of refusing it). */
+typedef struct BinaryHeader {
+    char magic[8]; /* BINARY_MAGIC */
+    uint64_t bytes;
+    uint64_t hash; /* FNV-1a of the bytes */
+} BinaryHeader;
+#define BINARY_MAGIC "vbclbin1"
+
+static uint64_t bytes_hash(const unsigned char *p, size_t n)
+{
+    uint64_t h = CACHE_HASH_SEED;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* Stores the program's binary under path with its header, written whole (temporary file
+ * + rename). */
 static void cache_store(cl_program prog, const char *path)
 {
     size_t size = 0;
     if (clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, NULL) || !size) return;
-    unsigned char *bin = malloc(size);
-    if (!bin) return;
-    unsigned char *bins[1] = {bin};
+    unsigned char *buf = malloc(sizeof(BinaryHeader) + size);
+    if (!buf) return;
+    unsigned char *bins[1] = {buf + sizeof(BinaryHeader)};
     if (clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins, NULL) == CL_SUCCESS) {
+        BinaryHeader h;
+        memset(&h, 0, sizeof h);
+        memcpy(h.magic, BINARY_MAGIC, sizeof h.magic);
+        h.bytes = size;
+        h.hash = bytes_hash(bins[0], size);
+        memcpy(buf, &h, sizeof h);
         char err[256]; /* a cache that cannot be written is only slower next time */
-        file_write_whole(path, bin, size, err, sizeof err);
+        file_write_whole(path, buf, sizeof h + size, err, sizeof err);
     }
-    free(bin);
+    free(buf);
+}
+
+/* The driver's bytes of a cached binary file of len bytes, or NULL when its header, length
+ * or hash is wrong (*n: their count). */
+static const unsigned char *cache_payload(const unsigned char *file, size_t len, size_t *n)
+{
+    BinaryHeader h;
+    if (len <= sizeof h) return NULL;
+    memcpy(&h, file, sizeof h);
+    if (memcmp(h.magic, BINARY_MAGIC, sizeof h.magic) || h.bytes != len - sizeof h ||
+        bytes_hash(file + sizeof h, len - sizeof h) != h.hash)
+        return NULL;
+    *n = len - sizeof h;
+    return file + sizeof h;
 }
 
 static void print_build_log(VbDevice *d, cl_program prog, const char *options)
@@ -425,11 +468,75 @@ static int driver_caches_kernels(const VbDevice *d)
  * by default only where the driver keeps no kernels of its own. On PoCL, asking for a
  * program's binary compiles every kernel of the program once more, for the binary, which
  * costs a cold run far more than a build from source through PoCL's kernel cache costs a
- * warm one over loading the binary (docs/architecture.md, "Kernel features"). */
+ * warm one over loading the binary (docs/architecture.md, "Kernel programs"). */
 static int binaries_wanted(const VbDevice *d)
 {
     int set = cache_binaries_setting();
     return set >= 0 ? set : !driver_caches_kernels(d);
+}
+
+/* The key of source built with options on d: it names the binary and the stamp. */
+static uint64_t program_key(const VbDevice *d, const char *source, const char *options)
+{
+    uint64_t h = CACHE_HASH_SEED;
+    h = cache_hash(h, source);
+    h = cache_hash(h, options);
+    h = cache_hash(h, d->name);
+    h = cache_hash(h, d->version);
+    return cache_hash(h, d->driver);
+}
+
+/* The stamp of a program key: an empty file in the cache's programs/ folder, written once
+ * the program and its kernels have been compiled on this device. Returns 0 or -1 (no cache
+ * directory). */
+static int stamp_path(uint64_t key, char *path, size_t n)
+{
+    char dir[4096];
+    if (!cache_dir("programs", dir, sizeof dir)) return -1;
+    snprintf(path, n, "%s/%016llx.built", dir, (unsigned long long)key);
+    return 0;
+}
+
+int clu_program_seen(const VbDevice *d, const char *source, const char *options)
+{
+    char path[4200];
+    if (stamp_path(program_key(d, source, options), path, sizeof path)) return 0;
+    if (access(path, F_OK) != 0) return 0;
+    cache_touch(path);
+    return 1;
+}
+
+void clu_program_mark_seen(const VbDevice *d, const char *source, const char *options)
+{
+    char path[4200], err[256];
+    if (stamp_path(program_key(d, source, options), path, sizeof path) == 0 &&
+        access(path, F_OK) != 0)
+        file_write_whole(path, "", 0, err, sizeof err); /* unwritten: a notice next time */
+}
+
+/* The program d keeps under key (a retained reference), or NULL. */
+static cl_program kept_find(VbDevice *d, uint64_t key)
+{
+    for (int i = 0; i < d->nkept; i++)
+        if (d->kept[i].key == key) {
+            if (clRetainProgram(d->kept[i].program) != CL_SUCCESS) return NULL;
+            return d->kept[i].program;
+        }
+    return NULL;
+}
+
+/* Keeps prog on d under key for later builds of the same program (the oldest goes first
+ * when all CLU_KEPT_PROGRAMS places are taken). */
+static void kept_add(VbDevice *d, uint64_t key, cl_program prog)
+{
+    if (clRetainProgram(prog) != CL_SUCCESS) return;
+    if (d->nkept == CLU_KEPT_PROGRAMS) {
+        CL_WARN(clReleaseProgram(d->kept[0].program));
+        memmove(d->kept, d->kept + 1, sizeof d->kept[0] * (CLU_KEPT_PROGRAMS - 1));
+        d->nkept--;
+    }
+    d->kept[d->nkept].key = key;
+    d->kept[d->nkept++].program = prog;
 }
 
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
@@ -437,31 +544,38 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
 {
     double t0 = clu_now_ms();
     cl_int rc;
-    cl_program prog = NULL;
+    uint64_t key = program_key(d, source, options);
+    cl_program prog = kept_find(d, key);
+    if (prog) {
+        *cached = CLU_KEPT;
+        *ms = clu_now_ms() - t0;
+        return prog;
+    }
+    int seen = clu_program_seen(d, source, options);
     *cached = CLU_BUILT;
     char dir[4096], path[4200] = "";
     uint64_t cache_max = 0; /* read on every run, so that a bad value is always named */
     int binaries = binaries_wanted(d);
-    if (!binaries) *cached = CLU_BUILT_DRIVER_CACHE;
+    if (!binaries && seen) *cached = CLU_BUILT_DRIVER_CACHE;
     if (binaries && cache_dir(NULL, dir, sizeof dir)) {
         cache_max = cache_max_bytes();
-        uint64_t h = CACHE_HASH_SEED;
-        h = cache_hash(h, source);
-        h = cache_hash(h, options);
-        h = cache_hash(h, d->name);
-        h = cache_hash(h, d->version);
-        h = cache_hash(h, d->driver);
-        snprintf(path, sizeof path, "%s/%016llx.bin", dir, (unsigned long long)h);
-        size_t len = 0;
-        unsigned char *bin = read_all(path, &len);
+        snprintf(path, sizeof path, "%s/%016llx.bin", dir, (unsigned long long)key);
+        size_t len = 0, n = 0;
+        unsigned char *file = read_all(path, &len);
+        const unsigned char *bin = file ? cache_payload(file, len, &n) : NULL;
+        if (file && !bin) {
+            fprintf(stderr, "vbcl: %s: a damaged cached kernel binary (%zu bytes); rebuilding it\n",
+                    path, len);
+            remove(path);
+        }
         if (bin) {
-            const unsigned char *bins[1] = {bin};
             cl_int status;
-            prog = clCreateProgramWithBinary(d->context, 1, &d->device, &len, bins, &status, &rc);
-            free(bin);
+            prog = clCreateProgramWithBinary(d->context, 1, &d->device, &n, &bin, &status, &rc);
             if (prog && rc == CL_SUCCESS && status == CL_SUCCESS &&
                 clBuildProgram(prog, 1, &d->device, options, NULL, NULL) == CL_SUCCESS) {
+                free(file);
                 cache_touch(path); /* recently used: pruned last */
+                kept_add(d, key, prog);
                 *cached = CLU_BINARY;
                 *ms = clu_now_ms() - t0;
                 return prog;
@@ -469,6 +583,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
             if (prog) clReleaseProgram(prog);
             prog = NULL; /* a stale or foreign binary: build from source */
         }
+        free(file);
     }
     prog = clCreateProgramWithSource(d->context, 1, &source, NULL, &rc);
     CL_CHECK_ERR(rc, "clCreateProgramWithSource", fail);
@@ -482,6 +597,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
         cache_store(prog, path);
         cache_prune(dir, ".bin", cache_max, path);
     }
+    kept_add(d, key, prog);
     *ms = clu_now_ms() - t0;
     return prog;
 fail_program:

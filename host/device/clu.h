@@ -8,6 +8,9 @@
 #include <stddef.h>
 #include <stdio.h>
 
+/* The most programs a device keeps built: the tracing programs, film and probe. */
+#define CLU_KEPT_PROGRAMS 6
+
 /* An OpenCL device with its context and an in-order profiling queue. */
 typedef struct VbDevice {
     cl_platform_id platform;
@@ -20,6 +23,13 @@ typedef struct VbDevice {
     char driver[128];  /* driver version */
     cl_ulong global_mem, max_alloc;
     size_t max_wg;
+    /* the programs built on this device, kept for later frames and renderers (released
+     * by clu_device_close) */
+    struct {
+        unsigned long long key;
+        cl_program program;
+    } kept[CLU_KEPT_PROGRAMS];
+    int nkept;
 } VbDevice;
 
 /* The name of an OpenCL error code ("CL_OUT_OF_RESOURCES"). */
@@ -92,19 +102,27 @@ void clu_devices_close(VbDevice *devs, int n);
 
 /* How clu_program_build got its program. */
 enum {
-    CLU_BUILT = 0,              /* built from source */
+    CLU_BUILT = 0,              /* compiled from source: the first time on this device */
     CLU_BINARY = 1,             /* loaded from vbcl's binary cache */
-    CLU_BUILT_DRIVER_CACHE = 2, /* built from source by a driver that keeps compiled
-                                 * kernels itself (PoCL): cold or warm, the time tells */
+    CLU_BUILT_DRIVER_CACHE = 2, /* built from source by a driver that keeps compiled kernels
+                                 * itself (PoCL), which has built it before */
+    CLU_KEPT = 3,               /* built earlier in this run (an earlier frame) */
 };
 
-/* Builds source with options for d. A binary cache keyed by source, options and device
- * is used unless VBCL_CACHE_DIR is "off", or the driver keeps its own kernel cache and
- * VBCL_CACHE_BINARIES is not 1; *cached says how the program came (CLU_BUILT ...) and
- * *ms the time taken. On a failed build the log and the options are printed to stderr.
- * Returns the program, or NULL (clu_error() says why). */
+/* Builds source with options for d, or returns the program d keeps from an earlier build
+ * of the same source and options (retained: the caller releases it). A binary cache keyed
+ * by source, options and device is used unless VBCL_CACHE_DIR is "off", or the driver keeps
+ * its own kernel cache and VBCL_CACHE_BINARIES is not 1; a cached binary whose header,
+ * length or hash is wrong is removed and rebuilt. *cached says how the program came
+ * (CLU_BUILT ...) and *ms the time taken. On a failed build the log and the options are
+ * printed to stderr. Returns the program, or NULL (clu_error() says why). */
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
                              int *cached);
+
+/* Whether this program has been compiled on d before, with its kernels launched
+ * (clu_program_mark_seen: a stamp in the cache's programs/ folder). */
+int clu_program_seen(const VbDevice *d, const char *source, const char *options);
+void clu_program_mark_seen(const VbDevice *d, const char *source, const char *options);
 
 /* A buffer of `bytes` (at least 16: zero-sized buffers are invalid), initialised from data
  * when not NULL. Returns NULL with the failure recorded (clu_error). */

@@ -933,6 +933,7 @@ int scene_buffers_upload(SceneBuffers *b, VbDevice *dev, const Scene *s, const G
     free(objs);
     if (rc) return rc;
     frame_fill(s, g, band_weights, f);
+    f->flags |= features_frame_flags(features);
     f->cam_tiles = ct;
     b->frame = clu_buffer(dev, NULL, sizeof *f, CL_MEM_READ_ONLY);
     if (b->frame) return 0;

@@ -8,11 +8,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The program's kernels by name, with the features each needs (render.h RENDER_KERNELS). */
-#define RENDER_KERNEL_ENTRY(id, name, needs) {name, offsetof(Renderer, k_##id), needs},
+/* The kernels by name, with their program and the features each needs (render.h
+ * RENDER_KERNELS). */
+#define RENDER_KERNEL_ENTRY(id, name, prog, frame, needs)                                          \
+    {name, offsetof(Renderer, k_##id), prog, frame, needs},
 static const struct {
     const char *name;
     size_t field;
+    int film;  /* in the film program */
+    int frame; /* starts with the frame's arguments */
     unsigned needs;
 } kernel_table[] = {RENDER_KERNELS(RENDER_KERNEL_ENTRY)};
 #undef RENDER_KERNEL_ENTRY
@@ -52,9 +56,31 @@ const size_t *renderer_local(const Renderer *r, size_t global)
     return r->local_size && global % r->local_size == 0 ? &r->local_size : NULL;
 }
 
-/* The grid, the program for the scene's features and its kernels. Returns 0, 1 (device)
- * or 2 (a grid the scene cannot have) with a message in err. */
-static int renderer_build(Renderer *r, const Scene *s, const char *extra_options, RenderStats *st,
+static int build_notice_on;
+
+void renderer_build_notice(int on)
+{
+    build_notice_on = on;
+}
+
+/* The film program's build options: it has no features. */
+static const char film_options[] = "-cl-std=CL1.2";
+
+/* Builds one program (clu_program_build) into *prog, adding its time to st->build_ms.
+ * Returns 0 or 1. */
+static int renderer_program(Renderer *r, const char *source, const char *options, cl_program *prog,
+                            int *cached, RenderStats *st)
+{
+    double ms = 0.0;
+    *prog = clu_program_build(r->dev, source, options, &ms, cached);
+    st->build_ms += ms;
+    return *prog ? 0 : 1;
+}
+
+/* The grid, the tracing program of the scene's class, the film program (and the probe
+ * program when asked), and the kernels the scene runs. Returns 0, 1 (device) or 2 (a grid
+ * the scene cannot have) with a message in err. */
+static int renderer_build(Renderer *r, const Scene *s, const char *probe_source, RenderStats *st,
                           char *err, size_t errlen)
 {
     char gerr[256];
@@ -68,24 +94,91 @@ static int renderer_build(Renderer *r, const Scene *s, const char *extra_options
     st->grid_ms = r->grid.build_ms;
     r->features = features_of_scene(s);
     st->features = r->features;
-    features_build_options(r->features, s, extra_options, st->options, sizeof st->options);
-    r->program = clu_program_build(r->dev, vbcl_kernel_source, st->options, &st->build_ms,
-                                   &st->build_cached);
-    if (!r->program) return 1;
+    st->program = features_program(r->features);
+    r->program_features =
+        features_programs_mode() == PROGRAMS_SCENE ? r->features : features_of_program(st->program);
+    features_build_options(r->features, s, st->options, sizeof st->options);
+    int fresh = !clu_program_seen(r->dev, vbcl_kernel_source, st->options) ||
+                !clu_program_seen(r->dev, vbcl_film_source, film_options);
+    if (fresh && build_notice_on) {
+        char feat[160];
+        features_describe(r->program_features & ~VBCL_FEATURE_FRESNEL_THESIS, feat, sizeof feat);
+        fprintf(stderr,
+                "vbcl: compiling the %s kernels (%s) for %s, first time only (vbcl --warm-cache "
+                "compiles every program ahead)\n",
+                features_program_name(st->program), feat, r->dev->name);
+    }
+    int film_cached;
+    st->build_ms = 0.0;
+    if (renderer_program(r, vbcl_film_source, film_options, &r->film, &film_cached, st) ||
+        renderer_program(r, vbcl_kernel_source, st->options, &r->program, &st->build_cached, st))
+        return 1;
+    if (probe_source) {
+        char popt[512];
+        int pc;
+        features_program_options(PROGRAM_DISPERSIVE, popt, sizeof popt);
+        if (renderer_program(r, probe_source, popt, &r->probe, &pc, st)) return 1;
+    }
     r->local_size = r->dev->max_wg >= 64 ? 64 : 0;
     for (int i = 0; i < KERNEL_COUNT; i++) {
         if ((r->features & kernel_table[i].needs) != kernel_table[i].needs) continue;
         cl_int rc;
         cl_kernel *k = kernel_slot(r, i);
-        *k = clCreateKernel(r->program, kernel_table[i].name, &rc);
+        *k = clCreateKernel(kernel_table[i].film ? r->film : r->program, kernel_table[i].name, &rc);
         if (rc != CL_SUCCESS) {
             snprintf(err, errlen, "%s: clCreateKernel(%s): %s", r->dev->name, kernel_table[i].name,
                      clu_error_name(rc));
             return 1;
         }
-        if (*k != r->k_camera) renderer_fit_local_size(r, *k);
+        renderer_fit_local_size(r, *k);
     }
     return 0;
+}
+
+/* One launch of every kernel the scene runs, on no work (a frame with no tile pixels, no
+ * rays, a zeroed anti-aliasing pass: every kernel's bounds guard returns at once), with the
+ * work-group size the render uses: a driver that compiles a kernel at its first launch
+ * (PoCL, once for each work-group size) compiles it here. Sets st->first_launch_ms and adds
+ * it to st->build_ms; marks the programs seen (clu_program_mark_seen). Returns 0 or -1. */
+static int renderer_first_launch(Renderer *r, RenderStats *st)
+{
+    VbDevice *d = r->dev;
+    double t0 = clu_now_ms();
+    int rc = -1;
+    static const unsigned char zeros[256];
+    cl_mem zero = clu_buffer(d, zeros, sizeof zeros, CL_MEM_READ_WRITE);
+    if (!zero) return -1;
+    VbFrame f = r->frame_host;
+    f.tile_pixels = 0;
+    CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof f, &f, 0, NULL, NULL),
+             done);
+    size_t global = r->local_size ? r->local_size : 64;
+    for (int i = 0; i < KERNEL_COUNT; i++) {
+        cl_kernel k = *kernel_slot(r, i);
+        if (!k) continue;
+        cl_uint nargs = 0, first = 0;
+        CL_CHECK(clGetKernelInfo(k, CL_KERNEL_NUM_ARGS, sizeof nargs, &nargs, NULL), done);
+        if (kernel_table[i].frame) {
+            if (renderer_set_frame_args(r, k, r->rays, 0, r->hits, r->media, r->radiance,
+                                        r->counters))
+                goto done;
+            first = RENDER_FRAME_ARGS;
+        }
+        for (cl_uint a = first; a < nargs; a++) /* the pass, marks, lists, trees, splits */
+            if (clu_set_arg(k, a, sizeof(cl_mem), &zero)) goto done;
+        CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, renderer_local(r, global), 0,
+                                        NULL, NULL),
+                 done);
+    }
+    CL_CHECK(clFinish(d->queue), done);
+    clu_program_mark_seen(d, vbcl_kernel_source, st->options);
+    clu_program_mark_seen(d, vbcl_film_source, film_options);
+    rc = 0;
+done:
+    CL_WARN(clReleaseMemObject(zero));
+    st->first_launch_ms = clu_now_ms() - t0;
+    st->build_ms += st->first_launch_ms;
+    return rc;
 }
 
 /* Tiles bounded so that 32-bit work counters of one tile cannot overflow, and the ray
@@ -108,24 +201,30 @@ static int renderer_alloc_rays(Renderer *r, const Scene *s)
     r->media = clu_buffer(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
     r->counters = clu_buffer(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
     if (!r->rays || !r->hits || !r->radiance || !r->media || !r->counters) return 1;
-    if (r->k_bands)
-        r->splits = clu_buffer(dev, NULL, sizeof(VbSplitSet) * (size_t)cap, CL_MEM_READ_WRITE);
-    return r->k_bands && !r->splits;
+    /* a program with dispersion takes the split records whether the scene disperses or not;
+     * only a dispersive scene writes them */
+    if (r->program_features & VBCL_FEATURE_DISPERSION)
+        r->splits = clu_buffer(dev, NULL, r->k_bands ? sizeof(VbSplitSet) * (size_t)cap : 0,
+                               CL_MEM_READ_WRITE);
+    return (r->program_features & VBCL_FEATURE_DISPERSION) && !r->splits;
 }
 
-int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
+int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_source,
                   RenderStats *st, char *err, size_t errlen)
 {
     memset(r, 0, sizeof *r);
     r->dev = dev;
     clu_error_clear();
     err[0] = '\0';
-    int rc = renderer_build(r, s, extra_options, st, err, errlen);
+    int rc = renderer_build(r, s, probe_source, st, err, errlen);
     double t0 = clu_now_ms();
     if (!rc)
         rc = scene_buffers_upload(&r->buf, dev, s, &r->grid, r->features, &r->frame_host, err,
                                   errlen);
     if (!rc) rc = renderer_alloc_rays(r, s);
+    double t1 = clu_now_ms();
+    if (!rc && renderer_first_launch(r, st)) rc = 1;
+    t0 += clu_now_ms() - t1; /* the first launches are build time, not upload */
     if (rc) {
         if (rc == 1 && !err[0])
             snprintf(err, errlen, "%s: %s", dev->name,
@@ -156,7 +255,7 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
         if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
                                     r->counters))
             goto done;
-        if (k >= 2 && r->k_bands &&
+        if (k >= 2 && r->splits &&
             clu_set_arg(stages[k], RENDER_FRAME_ARGS, sizeof(cl_mem), &r->splits))
             goto done;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global,
@@ -201,7 +300,8 @@ int renderer_trace_tile(Renderer *r, long first, int n, float *rgba, RenderStats
     if (renderer_set_frame_args(r, r->k_camera, r->rays, n, r->hits, r->media, r->radiance,
                                 r->counters))
         goto done;
-    CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_camera, 1, NULL, &global, NULL, 0, NULL, &ev[0]),
+    CL_CHECK(clEnqueueNDRangeKernel(d->queue, r->k_camera, 1, NULL, &global,
+                                    renderer_local(r, global), 0, NULL, &ev[0]),
              done);
     if (renderer_trace_rays(r, n, st, NULL)) goto done;
     CL_CHECK(clEnqueueReadBuffer(d->queue, r->radiance, CL_TRUE, 0, sizeof(float) * 4 * (size_t)n,
@@ -231,7 +331,11 @@ void renderer_release(Renderer *r)
             CL_WARN(clReleaseKernel(*kernel_slot(r, i)));
             *kernel_slot(r, i) = NULL;
         }
-    if (r->program) CL_WARN(clReleaseProgram(r->program));
-    r->program = NULL;
+    cl_program *progs[] = {&r->program, &r->film, &r->probe};
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
+        if (*progs[i]) {
+            CL_WARN(clReleaseProgram(*progs[i]));
+            *progs[i] = NULL;
+        }
     grid_free(&r->grid);
 }

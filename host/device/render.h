@@ -23,7 +23,10 @@ typedef struct RenderStats {
     unsigned features;
     char options[512];
     double build_ms;
-    int build_cached; /* how the program came: CLU_BUILT, CLU_BINARY, CLU_BUILT_DRIVER_CACHE */
+    int build_cached;       /* how the tracing program came: CLU_BUILT, CLU_BINARY, ... (clu.h) */
+    double first_launch_ms; /* the kernels' empty first launches (in build_ms): a driver
+                             * that compiles each kernel at its first launch does it here */
+    int program;            /* PROGRAM_* (kernel_features.h) */
     double grid_ms, upload_ms;
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
     double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
@@ -37,30 +40,34 @@ typedef struct RenderStats {
     double aa_contrast_ms, aa_refine_ms, aa_reconstruct_ms; /* event profiling */
 } RenderStats;
 
-/* The kernels of the program, one list: X(Renderer field suffix, kernel name, the
- * VBCL_FEATURE_* bits without which the program has no such kernel). */
+/* The kernels, one list: X(Renderer field suffix, kernel name, program: 0 the tracing
+ * program (render.cl), 1 the film program (film.cl), whether it starts with the frame's
+ * arguments (FRAME_KERNEL_ARGS), the VBCL_FEATURE_* bits without which the scene does not
+ * run it). */
 #define RENDER_KERNELS(X)                                                                          \
-    X(camera, "camera_generate_rays", 0u)                                                          \
-    X(intersect, "scene_intersect_closest", 0u)                                                    \
-    X(shading, "light_sample_shading", 0u)                                                         \
-    X(tree, "tree_trace_secondary", VBCL_FEATURE_TRANSPARENCY)                                     \
-    X(bands, "tree_trace_bands", VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)              \
-    X(aa_generate, "aa_generate_rays", 0u)                                                         \
-    X(aa_contrast, "aa_contrast_mark", 0u)                                                         \
-    X(aa_contrast_list, "aa_contrast_list", 0u)                                                    \
-    X(aa_dirty_list, "aa_dirty_list", 0u)                                                          \
-    X(aa_reconstruct, "aa_reconstruct", 0u)                                                        \
-    X(aa_split_rays, "aa_split_rays", 0u)                                                          \
-    X(aa_split_store, "aa_split_store", 0u)                                                        \
-    X(aa_resolve, "aa_resolve", 0u)
+    X(camera, "camera_generate_rays", 0, 1, 0u)                                                    \
+    X(intersect, "scene_intersect_closest", 0, 1, 0u)                                              \
+    X(shading, "light_sample_shading", 0, 1, 0u)                                                   \
+    X(tree, "tree_trace_secondary", 0, 1, VBCL_FEATURE_TRANSPARENCY)                               \
+    X(bands, "tree_trace_bands", 0, 1, VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)        \
+    X(aa_generate, "aa_generate_rays", 0, 1, 0u)                                                   \
+    X(aa_split_rays, "aa_split_rays", 0, 1, 0u)                                                    \
+    X(aa_contrast, "aa_contrast_mark", 1, 0, 0u)                                                   \
+    X(aa_contrast_list, "aa_contrast_list", 1, 0, 0u)                                              \
+    X(aa_dirty_list, "aa_dirty_list", 1, 0, 0u)                                                    \
+    X(aa_reconstruct, "aa_reconstruct", 1, 0, 0u)                                                  \
+    X(aa_split_store, "aa_split_store", 1, 0, 0u)                                                  \
+    X(aa_resolve, "aa_resolve", 1, 0, 0u)
 
 /* A scene on a device, ready to trace: its buffers, the program and its kernels, and one
  * batch of rays (camera rays of a tile, or subpixel rays of anti-aliasing) at a time. */
 typedef struct Renderer {
     VbDevice *dev;
-    cl_program program;
-#define RENDER_KERNEL_FIELD(id, name, needs) cl_kernel k_##id;
-    RENDER_KERNELS(RENDER_KERNEL_FIELD) /* NULL where the features leave one out */
+    cl_program program; /* the tracing program of the scene's class (kernel_features.h) */
+    cl_program film;    /* anti-aliasing's film kernels, the same for every scene */
+    cl_program probe;   /* the tests' probe kernels (renderer_init's probe_source), or NULL */
+#define RENDER_KERNEL_FIELD(id, name, prog, frame, needs) cl_kernel k_##id;
+    RENDER_KERNELS(RENDER_KERNEL_FIELD) /* NULL where the scene's features leave one out */
 #undef RENDER_KERNEL_FIELD
     SceneBuffers buf;
     cl_mem rays, hits, media, radiance, counters;
@@ -72,16 +79,20 @@ typedef struct Renderer {
     size_t local_size; /* work-group size of the tracing and anti-aliasing kernels, or 0 for
                         * the driver's choice: fixed, so that PoCL compiles one work-group
                         * function per kernel however the batch sizes vary */
-    unsigned features;
+    unsigned features; /* the scene's (VBCL_FEATURE_*) */
+    unsigned program_features; /* those compiled into r->program, a superset */
 } Renderer;
 
 /* The ray buffers hold at least one pixel's samples at the deepest anti-aliasing level. */
 #define RENDER_MIN_BATCH_RAYS (1 << (2 * VBCL_AA_MAX_LEVEL))
 
-/* Prepares s for rendering on dev: grid, program (extra build options appended, may be
- * NULL), buffers. Returns 0, or 1 (device failure) / 2 (the scene cannot be rendered as
- * given, e.g. a grid too large) with a message in err. */
-int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *extra_options,
+/* Prepares s for rendering on dev: grid, programs (kept on dev for later frames: clu.h),
+ * buffers, and one empty launch of each kernel the scene runs, so that a driver that
+ * compiles a kernel at its first launch (PoCL) does so here, counted in st->build_ms and
+ * not in the render. probe_source: the tests' probe program (built as the dispersive
+ * class, into r->probe), or NULL. Returns 0, or 1 (device failure) / 2 (the scene cannot
+ * be rendered as given, e.g. a grid too large) with a message in err. */
+int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_source,
                   RenderStats *st, char *err, size_t errlen);
 
 /* Traces one tile of pass 0: a ray through the centre of each of the n pixels from
@@ -107,10 +118,18 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms);
 /* The local size argument of clEnqueueNDRangeKernel for the global size `global`. */
 const size_t *renderer_local(const Renderer *r, size_t global);
 
+/* Whether renderer_init says on stderr that it compiles a program for the first time on
+ * the device (vbcl turns it on when stderr is a terminal and -q is not given). */
+void renderer_build_notice(int on);
+
 /* Releases everything renderer_init created. */
 void renderer_release(Renderer *r);
 
-/* The kernel sources, embedded at build time (build/kernel_source.c). */
+/* The kernel sources, embedded at build time (build/kernel_source.c): the tracing program
+ * (render.cl) and the film program (film.cl). The test binaries also embed probe.cl
+ * (build/probe_source.c: vbcl_probe_source). */
 extern const char vbcl_kernel_source[];
+extern const char vbcl_film_source[];
+extern const char vbcl_probe_source[]; /* linked into the test binaries only */
 
 #endif

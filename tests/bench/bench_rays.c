@@ -215,9 +215,7 @@ static int create_kernels(Bench *b)
                 {&b->k_secondary, "probe_secondary_rays"}};
     for (size_t i = 0; i < sizeof list / sizeof list[0]; i++) {
         cl_int rc;
-        if (list[i].k == &b->k_secondary && !(b->r.features & VBCL_FEATURE_TRANSPARENCY))
-            continue; /* compiled only for scenes with dielectrics */
-        *list[i].k = clCreateKernel(b->r.program, list[i].name, &rc);
+        *list[i].k = clCreateKernel(b->r.probe, list[i].name, &rc);
         CL_CHECK_ERR(rc, list[i].name, fail);
     }
     return 0;
@@ -833,7 +831,7 @@ static int bench_open(Bench *b)
     int rc =
         clu_device_open(o->device ? o->device : getenv("VBCL_DEVICE"), &b->dev, err, sizeof err);
     if (!rc) {
-        rc = renderer_init(&b->r, &b->dev, &b->s, "-DVBCL_TEST_KERNELS", &b->st, err, sizeof err);
+        rc = renderer_init(&b->r, &b->dev, &b->s, vbcl_probe_source, &b->st, err, sizeof err);
         if (rc) clu_device_close(&b->dev);
     }
     if (rc) {
