@@ -110,7 +110,7 @@ $(BUILD)/image_plugin_blob.o: $(BUILD)/libvbcl_image.so
 	    'vbcl_image_plugin_end:' '.section .note.GNU-stack,"",@progbits' > $(BUILD)/image_plugin_blob.s
 	$(Q)$(CC) -c -o $@ $(BUILD)/image_plugin_blob.s
 
-$(BUILD)/vbcl-tests: $(TEST_OBJ) $(LIB_OBJ)
+$(BUILD)/vbcl-tests: $(TEST_OBJ) $(LIB_OBJ) $(BUILD)/probe_source.o
 	@echo "  LINK    $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
@@ -129,23 +129,38 @@ $(BUILD)/tests/%.o: tests/%.c build/config.mk
 	@echo "  CC      $<"
 	$(Q)$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -c -o $@ $<
 
-# The kernels are embedded in the binary: render.cl and everything it includes.
+# The kernels are embedded in the binary: render.cl (the tracing program) and film.cl
+# (anti-aliasing's film kernels), each with everything it includes; the test binaries also
+# embed probe.cl, the tests' own program.
 $(BUILD)/embed_kernels: scripts/embed_kernels.c
 	@mkdir -p $(dir $@)
 	$(Q)$(CC) $(CSTD) -O1 $(WARN) -o $@ $<
 
 $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed_kernels
-	@echo "  EMBED   kernels/render.cl"
-	$(Q)$(BUILD)/embed_kernels kernels render.cl $@
+	@echo "  EMBED   kernels/render.cl kernels/film.cl"
+	$(Q)$(BUILD)/embed_kernels kernels $@ vbcl_kernel_source=render.cl vbcl_film_source=film.cl
 
 $(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
 	$(Q)$(CC) $(CSTD) -O0 -c -o $@ $<
 
-# Renders the quickstart scene: what a new user runs first.
-run: vbcl
+$(BUILD)/probe_source.c: $(KERNELS) $(BUILD)/embed_kernels
+	@echo "  EMBED   kernels/probe.cl"
+	$(Q)$(BUILD)/embed_kernels kernels $@ vbcl_probe_source=probe.cl
+
+$(BUILD)/probe_source.o: $(BUILD)/probe_source.c
+	$(Q)$(CC) $(CSTD) -O0 -c -o $@ $<
+
+# Renders the quickstart scene: what a new user runs first. The kernel programs are
+# compiled first, on every core (vbcl --warm-cache: a minute or so on 2 cores the first
+# time, a second after), so that this render and a user's own scenes compile nothing. The
+# host is built on every core too.
+run:
+	$(Q)$(MAKE) --no-print-directory -j$$(nproc) vbcl
+	./vbcl --warm-cache
 	./vbcl scenes/quickstart.json -o quickstart.png
 
-# Runs every test (kernels on the default OpenCL device). Sanitizer builds run the tests
+# Runs every test (kernels on the default OpenCL device), after vbcl --warm-cache has
+# compiled the kernel programs on every core. Sanitizer builds run the tests
 # against their own instrumented vbcl. intercept_tls_get_addr=0: the __tls_get_addr
 # interceptor of GCC's sanitizer runtime (up to GCC 13) takes a dynamic TLS block that
 # malloc happens to place 16 bytes past a 4 KiB boundary for a glibc 2.18 one and reads a
@@ -158,6 +173,7 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 # `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
 # mean nothing.
 test: $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
+	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
 	$(Q)scripts/gallery.py --vbcl $(BUILD)/vbcl --size 16 --scenes a1,a6 --out $(BUILD)/gallery-quick \
@@ -208,7 +224,7 @@ $(BUILD)/tests/bench/embree.cfg: FORCE
 	$(Q)echo "embree=$(EMBREE)" | cmp -s - $@ || echo "embree=$(EMBREE)" > $@
 
 $(BUILD)/vbcl-bench-rays: $(BUILD)/tests/bench/bench_rays.o $(BENCH_EMBREE_OBJ) $(LIB_OBJ) \
-                          $(BUILD)/tests/bench/embree.cfg
+                          $(BUILD)/probe_source.o $(BUILD)/tests/bench/embree.cfg
 	@echo "  LINK    $@$(if $(EMBREE),, (without Embree: not installed))"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LDLIBS) $(if $(EMBREE),-lembree3) -lpthread
 
@@ -220,7 +236,8 @@ bench-grid: vbcl
 
 # Stress run (docs/testing.md): 10^7 rays at the edges and vertices of closed meshes at
 # three scales, and an 8192x8192 render. Too long for `make test`, which runs a 10^5 version.
-$(BUILD)/vbcl-stress: $(BUILD)/tests/stress/stress_main.o $(BUILD)/tests/watertight.o $(LIB_OBJ)
+$(BUILD)/vbcl-stress: $(BUILD)/tests/stress/stress_main.o $(BUILD)/tests/watertight.o $(LIB_OBJ) \
+                      $(BUILD)/probe_source.o
 	@echo "  LINK    $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 

@@ -22,6 +22,7 @@
 #include "scene.h"
 #include "stats.h"
 #include "texgen.h"
+#include "warm.h"
 
 #define VBCL_VERSION "0.1.0"
 
@@ -32,6 +33,7 @@ static int mpi_rank = -1; /* this process's rank in an MPI run of several, else 
 static const char usage_text[] =
     "usage: vbcl SCENE.json [options]\n"
     "       vbcl --list-devices\n"
+    "       vbcl --warm-cache [--device ...]\n"
     "\n"
     "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
     "the extension: .png .jpg .tif (8-bit sRGB), .exr or .pfm (linear float; vbcl writes\n"
@@ -103,6 +105,9 @@ static const char usage_text[] =
     "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
     "                           tiles among several (refinement runs on the first)\n"
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
+    "      --warm-cache         compile every kernel program for the chosen devices, all\n"
+    "                           cores at once, and exit: later renders compile nothing\n"
+    "                           (make run does it first; a minute or two on 2 cores)\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
     "      --stats-json FILE    write the same statistics as JSON (fields: docs/stats.md);\n"
     "                           an animation's frames go into one array, \"frames\"\n"
@@ -110,11 +115,15 @@ static const char usage_text[] =
     "  -h, --help               show this help\n"
     "      --version            show the version\n"
     "\n"
-    "environment: VBCL_DEVICE (as --device), VBCL_CACHE_DIR (kernel binary cache;\n"
-    "\"off\" disables it; default ~/.cache/vbcl), VBCL_CACHE_MAX_MB (its size, default 256),\n"
+    "environment: VBCL_DEVICE (as --device), VBCL_CACHE_DIR (vbcl's cache: kernel\n"
+    "binaries, the stamps of programs compiled, textures; \"off\" disables it; default\n"
+    "~/.cache/vbcl), VBCL_CACHE_MAX_MB (its binaries' size, default 256),\n"
     "VBCL_CACHE_BINARIES (1: store binaries on every driver, 0: on none; default: not on\n"
-    "PoCL, which keeps its own kernel cache), VBCL_IMAGE_HELPER (0: load OpenImageIO in\n"
-    "vbcl itself rather than in a helper process that writes the PNG, JPEG, TIFF or EXR)\n"
+    "PoCL, which keeps compiled kernels in its own cache, POCL_CACHE_DIR, default\n"
+    "~/.cache/pocl/kcache), VBCL_KERNEL_PROGRAMS (classes, the default; scene: a program\n"
+    "of each scene's exact features, for comparison), VBCL_IMAGE_HELPER (0: load\n"
+    "OpenImageIO in vbcl itself rather than in a helper process that writes the PNG,\n"
+    "JPEG, TIFF or EXR); to clear the compiled kernels remove both cache folders\n"
     "mpirun -np N vbcl SCENE.json ...: the ranks share a still image's tiles, and an\n"
     "animation's frames (frame by frame in tiles with --stats-json); docs/scaling.md\n"
     "exit status: 0 success, 2 bad input or usage, 1 device or render failure\n"
@@ -128,7 +137,8 @@ typedef struct Options {
     int width, height, shadow_samples, depth, aa_max_level, aa_min_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
-    int list_devices, stats, quiet, no_cone_test, no_camera_tiles, all_feelers, penumbra_feelers;
+    int list_devices, warm_cache, stats, quiet, no_cone_test, no_camera_tiles, all_feelers,
+        penumbra_feelers;
     int no_sample_shares;
 } Options;
 
@@ -204,6 +214,7 @@ static const OptionSpec option_specs[] = {
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
     {"--stats-json", NULL, OPT_STRING, offsetof(Options, stats_json), 0, 0},
     {"--list-devices", NULL, OPT_FLAG, offsetof(Options, list_devices), 0, 0},
+    {"--warm-cache", NULL, OPT_FLAG, offsetof(Options, warm_cache), 0, 0},
     {"--no-cone-test", NULL, OPT_FLAG, offsetof(Options, no_cone_test), 0, 0},
     {"--no-camera-tiles", NULL, OPT_FLAG, offsetof(Options, no_camera_tiles), 0, 0},
     {"--all-feelers", NULL, OPT_FLAG, offsetof(Options, all_feelers), 0, 0},
@@ -341,7 +352,10 @@ static int parse_args(int argc, char **argv, Options *o)
             o->scene = a;
         }
     }
-    if (!o->scene && !o->list_devices) return usage_error("%s", "no scene file given");
+    if (o->warm_cache && o->scene)
+        return usage_error("--warm-cache takes no scene (got %s)", diag_value(o->scene));
+    if (!o->scene && !o->list_devices && !o->warm_cache)
+        return usage_error("%s", "no scene file given");
     if (o->penumbra_feelers && !scene_penumbra_feelers_ok(o->penumbra_feelers))
         return usage_error("--penumbra-feelers %d: expected " SCENE_PENUMBRA_FEELERS_SET,
                            o->penumbra_feelers);
@@ -551,6 +565,11 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
     long npix = (long)s->width * s->height;
     int shared = d && d->size > 1;
     TileSource src;
+    /* the image library first: without the helper process it loads on a thread of vbcl,
+     * and the kernels' first launches (frame_init) would wait for its dynamic loads */
+    double tl = clu_now_ms();
+    image_preload_wait();
+    *image_wait_ms = clu_now_ms() - tl;
     int rc = frame_init(fr, devs, ndev, s, st, err, sizeof err);
     if (shared) {
         int tile = rc ? TILES_MIN_PIXELS : tiles_size(fr->r.tile_pixels, npix, d->size * ndev);
@@ -564,9 +583,6 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
     }
     if (!rc) {
         int progress = !o->quiet && isatty(STDERR_FILENO);
-        double tl = clu_now_ms();
-        image_preload_wait(); /* the kernels' first launches would wait for it inside */
-        *image_wait_ms = clu_now_ms() - tl;
         rc = frame_render(fr, s, rgba, st, progress, err, sizeof err) ? 1 : 0;
     }
     if (shared) dist_tiles_end(d);
@@ -791,6 +807,15 @@ static int render_all(const Options *o, Dist *d, const char *text, int first, in
     return rc;
 }
 
+/* vbcl --warm-cache: every program on the chosen devices, as many at once as there are
+ * cores. Returns the exit status. */
+static int warm_main(const Options *o)
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    const char *spec = o->device ? o->device : getenv("VBCL_DEVICE");
+    return warm_cache(spec, cores > 0 ? (int)cores : 1, o->quiet);
+}
+
 /* The command line on this rank: the scene read and checked by rank 0 (once: it may be a
  * pipe), every frame and output path checked before any device is opened, then shared
  * with the other ranks; each rank opens its devices; then render_all. */
@@ -800,6 +825,8 @@ static int run(Dist *d, int argc, char **argv, double t0)
     int rc = parse_args(argc, argv, &o);
     if (rc >= 0) return rc;
     if (o.list_devices) return clu_list_devices(stdout) > 0 ? 0 : 1;
+    if (o.warm_cache) return warm_main(&o);
+    renderer_build_notice(!o.quiet && isatty(STDERR_FILENO) && d->rank <= 0);
     char err[1024] = "", *text = NULL;
     int first = -1, last = -2;
     Scene still;
