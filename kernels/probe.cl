@@ -695,14 +695,15 @@ VB_INLINE int probe_primary_point(const DevScene *sc, __global const VbRay *rays
     if (h.tri < 0) return 0;
     VbRay r = rays[i];
     float3 dir = vb_load3(r.dir);
-#ifdef VBCL_HAS_MEDIA
-    VbMedium before = media[i];
-    uint material = medium_cross(sc, h.tri, dir, before).surface;
-#else
-    (void)media;
     VbMedium before = {-1, 0u};
-    uint material = scene_tri_material(sc, h.tri);
+    uint material;
+#ifdef VBCL_HAS_MEDIA
+    if (FRAME_MEDIA(sc->f)) { /* scene_intersect_closest wrote media[i] */
+        before = media[i];
+        material = medium_cross(sc, h.tri, dir, before).surface;
+    } else
 #endif
+        material = scene_tri_material(sc, h.tri);
     *sp = shade_point_make(sc, dir, h, sample_key(sc->f, r.sample), before, material);
     return 1;
 }

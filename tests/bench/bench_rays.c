@@ -215,6 +215,8 @@ static int create_kernels(Bench *b)
                 {&b->k_secondary, "probe_secondary_rays"}};
     for (size_t i = 0; i < sizeof list / sizeof list[0]; i++) {
         cl_int rc;
+        if (list[i].k == &b->k_secondary && !(b->r.features & VBCL_FEATURE_TRANSPARENCY))
+            continue; /* the scene has no ray trees */
         *list[i].k = clCreateKernel(b->r.probe, list[i].name, &rc);
         CL_CHECK_ERR(rc, list[i].name, fail);
     }
