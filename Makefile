@@ -159,8 +159,8 @@ run:
 	./vbcl --warm-cache
 	./vbcl scenes/quickstart.json -o quickstart.png
 
-# Runs every test (kernels on the default OpenCL device), after vbcl --warm-cache has
-# compiled the kernel programs on every core. Sanitizer builds run the tests
+# Runs every test (kernels on the default OpenCL device), after the binaries are built and
+# vbcl --warm-cache has compiled the kernel programs, both on every core. Sanitizer builds run the tests
 # against their own instrumented vbcl. intercept_tls_get_addr=0: the __tls_get_addr
 # interceptor of GCC's sanitizer runtime (up to GCC 13) takes a dynamic TLS block that
 # malloc happens to place 16 bytes past a 4 KiB boundary for a glibc 2.18 one and reads a
@@ -172,7 +172,8 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 # (scripts/bench.py --quick) and scripts/bench_rays_compare.py on one, so that `make gallery`,
 # `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
 # mean nothing.
-test: $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
+test:
+	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
