@@ -152,7 +152,7 @@ static int renderer_first_launch(Renderer *r, RenderStats *st)
     f.tile_pixels = 0;
     CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof f, &f, 0, NULL, NULL),
              done);
-    size_t global = r->local_size ? r->local_size : 64;
+    size_t global = r->local_size ? r->local_size : 64, whole = 65536;
     for (int i = 0; i < KERNEL_COUNT; i++) {
         cl_kernel k = *kernel_slot(r, i);
         if (!k) continue;
@@ -169,6 +169,12 @@ static int renderer_first_launch(Renderer *r, RenderStats *st)
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, renderer_local(r, global), 0,
                                         NULL, NULL),
                  done);
+        /* the film kernels also run over a whole image, 65536 work items or more: PoCL
+         * compiles a second function for that */
+        if (kernel_table[i].film)
+            CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &whole, renderer_local(r, whole),
+                                            0, NULL, NULL),
+                     done);
     }
     CL_CHECK(clFinish(d->queue), done);
     clu_program_mark_seen(d, vbcl_kernel_source, st->options);
@@ -181,6 +187,11 @@ done:
     return rc;
 }
 
+/* The most pixels of a tile, and so the most work items of a tracing launch: below 65536,
+ * where PoCL compiles a second work-group function of every kernel (a "large grid" one),
+ * so that the first launches (renderer_first_launch) compile all a render runs. */
+#define RENDER_MAX_TILE (65536 - 64)
+
 /* Tiles bounded so that 32-bit work counters of one tile cannot overflow, and the ray
  * buffers for a tile (at least one pixel's deepest supersamples). Returns 0 or 1. */
 static int renderer_alloc_rays(Renderer *r, const Scene *s)
@@ -189,7 +200,7 @@ static int renderer_alloc_rays(Renderer *r, const Scene *s)
     VbDevice *dev = r->dev;
     long npix = (long)s->width * s->height;
     long per_pixel = 1 + (long)s->nlights * (long)(f->shadow_strata * f->shadow_strata);
-    long tile = 65536;
+    long tile = RENDER_MAX_TILE;
     while (tile > 256 && tile * per_pixel > (1L << 24)) tile /= 2;
     if (tile > npix) tile = npix;
     r->tile_pixels = (int)tile;
