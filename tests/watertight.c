@@ -14,7 +14,7 @@
 #include "render.h"
 #include "scene.h"
 
-#define WT_BATCH 65536 /* targets per device round trip */
+#define WT_BATCH 32768 /* targets per device round trip (below PoCL's large grid) */
 #define WT_AIMED 3     /* aimed rays per target at most (and 2 offset rays per hit) */
 
 typedef struct D3 {
