@@ -497,13 +497,19 @@ static int stamp_path(uint64_t key, char *path, size_t n)
     return 0;
 }
 
-int clu_program_seen(const VbDevice *d, const char *source, const char *options)
+/* Whether the stamp of key is there (renewed when it is). */
+static int stamp_seen(uint64_t key)
 {
     char path[4200];
-    if (stamp_path(program_key(d, source, options), path, sizeof path)) return 0;
+    if (stamp_path(key, path, sizeof path)) return 0;
     if (access(path, F_OK) != 0) return 0;
     cache_touch(path);
     return 1;
+}
+
+int clu_program_seen(const VbDevice *d, const char *source, const char *options)
+{
+    return stamp_seen(program_key(d, source, options));
 }
 
 void clu_program_mark_seen(const VbDevice *d, const char *source, const char *options)
@@ -551,7 +557,7 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
         *ms = clu_now_ms() - t0;
         return prog;
     }
-    int seen = clu_program_seen(d, source, options);
+    int seen = stamp_seen(key);
     *cached = CLU_BUILT;
     char dir[4096], path[4200] = "";
     uint64_t cache_max = 0; /* read on every run, so that a bad value is always named */
