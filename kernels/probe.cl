@@ -850,10 +850,12 @@ __kernel void probe_feeler_walk(SCENE_KERNEL_ARGS __global const VbRay *feelers,
     float left = r.tmax;
     uint k = 0;
     float last = -1.0f;
-#ifdef VBCL_HAS_TRANSPARENCY
-    VbMedium state = media[r.sample];
+    /* the walk of the scene's own program: media only where it has transparency */
+    int walk = (sc.f->flags & VBCL_FRAME_TRANSPARENCY) != 0u;
+    VbMedium state = {-1, 0u};
+    if (walk) state = media[r.sample];
     float3 trans = (float3)(1.0f);
-    for (int guard = 0; guard < 1024; guard++) {
+    for (int guard = 0; walk && guard < 1024; guard++) {
         uint mb = medium_material(&sc, state);
         VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);
         k++;
@@ -876,12 +878,11 @@ __kernel void probe_feeler_walk(SCENE_KERNEL_ARGS __global const VbRay *feelers,
         left -= seg;
         o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc.tris, h.tri));
     }
-#else
-    (void)media;
-    VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);
-    k = 1;
-    if (h.tri >= 0) last = dot(tri_point(sc.tris, h) - org, dir);
-#endif
+    if (!walk) {
+        VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);
+        k = 1;
+        if (h.tri >= 0) last = dot(tri_point(sc.tris, h) - org, dir);
+    }
     steps[i] = k;
     end[i] = last;
 }
