@@ -151,7 +151,7 @@ $(BUILD)/probe_source.o: $(BUILD)/probe_source.c
 	$(Q)$(CC) $(CSTD) -O0 -c -o $@ $<
 
 # Renders the quickstart scene: what a new user runs first. The kernel programs are
-# compiled first, on every core (vbcl --warm-cache: a minute or so on 2 cores the first
+# compiled first, on every core (vbcl --warm-cache: 2 – 2.5 minutes on 2 cores the first
 # time, a second after), so that this render and a user's own scenes compile nothing. The
 # host is built on every core too.
 run:
