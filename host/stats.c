@@ -25,20 +25,17 @@ static double per(unsigned long long a, unsigned long long b)
 
 /* ---- the --stats text ---- */
 
-/* How the program came (RenderStats.build_cached: CLU_BUILT, CLU_BINARY,
- * CLU_BUILT_DRIVER_CACHE, CLU_KEPT), as --stats says it and as --stats-json's program.from. */
-static const struct BuildSource {
-    const char *text, *json;
-} build_sources[] = {
-    [CLU_BUILT] = {"compiled from source: no earlier build of it in vbcl's cache", "source"},
-    [CLU_BINARY] = {"loaded from vbcl's binary cache", "binary"},
-    [CLU_BUILT_DRIVER_CACHE] = {"built through the driver's kernel cache", "source_driver_cache"},
-    [CLU_KEPT] = {"kept from an earlier frame", "kept"},
-};
-
-static const struct BuildSource *build_source(int how)
+/* How the program came (RenderStats.build_cached: CLU_BUILT ...) as --stats-json's
+ * program.from; --stats says it in words (clu_build_how). */
+static const char *build_source_json(int how)
 {
-    return &build_sources[how >= CLU_BUILT && how <= CLU_KEPT ? how : CLU_BUILT];
+    static const char *const json[] = {
+        [CLU_BUILT] = "source",
+        [CLU_BINARY] = "binary",
+        [CLU_BUILT_DRIVER_CACHE] = "source_driver_cache",
+        [CLU_KEPT] = "kept",
+    };
+    return json[how >= CLU_BUILT && how <= CLU_KEPT ? how : CLU_BUILT];
 }
 
 /* scene, device, features, program, grid */
@@ -55,7 +52,7 @@ static void print_setup(FILE *f, const StatsFrame *fr)
     fprintf(f, "device      %s (%s)\n", fr->dev->name, fr->dev->version);
     fprintf(f, "features    %s\n", feat);
     fprintf(f, "program     %s, %.1f ms (%s; first launches %.1f ms), options: %s\n",
-            features_program_name(st->program), st->build_ms, build_source(st->build_cached)->text,
+            features_program_name(st->program), st->build_ms, clu_build_how(st->build_cached),
             st->first_launch_ms, st->options);
     fprintf(f,
             "grid        %dx%dx%d = %u cells (%s), build %.1f ms, triangles per cell mean %.2f max "
@@ -266,7 +263,7 @@ static void json_setup(cJSON *root, const StatsFrame *fr, int *ok)
     num(o, "build_ms", st->build_ms, ok);
     num(o, "first_launch_ms", st->first_launch_ms, ok);
     flag(o, "cached", st->build_cached == CLU_BINARY, ok);
-    str(o, "from", build_source(st->build_cached)->json, ok);
+    str(o, "from", build_source_json(st->build_cached), ok);
     str(o, "options", st->options, ok);
 }
 

@@ -545,6 +545,17 @@ static void kept_add(VbDevice *d, uint64_t key, cl_program prog)
     d->kept[d->nkept++].program = prog;
 }
 
+const char *clu_build_how(int how)
+{
+    static const char *const text[] = {
+        [CLU_BUILT] = "compiled from source: no earlier build of it in vbcl's cache",
+        [CLU_BINARY] = "loaded from vbcl's binary cache",
+        [CLU_BUILT_DRIVER_CACHE] = "built through the driver's kernel cache",
+        [CLU_KEPT] = "kept from an earlier frame",
+    };
+    return text[how >= CLU_BUILT && how <= CLU_KEPT ? how : CLU_BUILT];
+}
+
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
                              int *cached)
 {

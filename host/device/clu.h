@@ -109,6 +109,9 @@ enum {
     CLU_KEPT = 3,               /* built earlier in this run (an earlier frame) */
 };
 
+/* How a program came (CLU_BUILT ...), as --stats and vbcl --warm-cache say it. */
+const char *clu_build_how(int how);
+
 /* Builds source with options for d, or returns the program d keeps from an earlier build
  * of the same source and options (retained: the caller releases it). A binary cache keyed
  * by source, options and device is used unless VBCL_CACHE_DIR is "off", or the driver keeps

@@ -118,6 +118,13 @@ unsigned features_of_program(int p)
     return programs[p].features;
 }
 
+unsigned features_compiled(unsigned scene_features)
+{
+    return features_programs_mode() == PROGRAMS_SCENE
+               ? scene_features
+               : features_of_program(features_program(scene_features));
+}
+
 const char *features_program_name(int p)
 {
     return programs[p].name;

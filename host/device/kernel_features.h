@@ -30,6 +30,9 @@ unsigned features_of_scene(const Scene *s);
 int features_program(unsigned scene_features);
 /* The features compiled into program p. */
 unsigned features_of_program(int p);
+/* The features compiled into the program a scene of these features runs on, as
+ * features_programs_mode says: its class's, or with "scene" exactly its own. */
+unsigned features_compiled(unsigned scene_features);
 /* The program's name in messages ("opaque", "dielectric", "dispersive"). */
 const char *features_program_name(int p);
 /* The VBCL_FRAME_* flags that tell a program which of its features the scene uses. */

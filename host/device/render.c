@@ -95,8 +95,7 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
     r->features = features_of_scene(s);
     st->features = r->features;
     st->program = features_program(r->features);
-    r->program_features =
-        features_programs_mode() == PROGRAMS_SCENE ? r->features : features_of_program(st->program);
+    r->program_features = features_compiled(r->features);
     features_build_options(r->features, s, st->options, sizeof st->options);
     int fresh = !clu_program_seen(r->dev, vbcl_kernel_source, st->options) ||
                 !clu_program_seen(r->dev, vbcl_film_source, film_options);
@@ -135,6 +134,10 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
     return 0;
 }
 
+/* The work items from which PoCL compiles a second work-group function of a kernel (its
+ * "large grid" one; measured: 64,000 items use the small one, 65,536 the large). */
+#define RENDER_LARGE_GRID 65536
+
 /* One launch of every kernel the scene runs, on no work (a frame with no tile pixels, no
  * rays, a zeroed anti-aliasing pass: every kernel's bounds guard returns at once), with the
  * work-group size the render uses: a driver that compiles a kernel at its first launch
@@ -152,7 +155,7 @@ static int renderer_first_launch(Renderer *r, RenderStats *st)
     f.tile_pixels = 0;
     CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof f, &f, 0, NULL, NULL),
              done);
-    size_t global = r->local_size ? r->local_size : 64, whole = 65536;
+    size_t global = r->local_size ? r->local_size : 64, whole = RENDER_LARGE_GRID;
     for (int i = 0; i < KERNEL_COUNT; i++) {
         cl_kernel k = *kernel_slot(r, i);
         if (!k) continue;
@@ -169,8 +172,7 @@ static int renderer_first_launch(Renderer *r, RenderStats *st)
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, renderer_local(r, global), 0,
                                         NULL, NULL),
                  done);
-        /* the film kernels also run over a whole image, 65536 work items or more: PoCL
-         * compiles a second function for that */
+        /* the film kernels also run over a whole image, as large a grid as it is */
         if (kernel_table[i].film)
             CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &whole, renderer_local(r, whole),
                                             0, NULL, NULL),
@@ -187,10 +189,10 @@ done:
     return rc;
 }
 
-/* The most pixels of a tile, and so the most work items of a tracing launch: below 65536,
- * where PoCL compiles a second work-group function of every kernel (a "large grid" one),
- * so that the first launches (renderer_first_launch) compile all a render runs. */
-#define RENDER_MAX_TILE (65536 - 64)
+/* The most pixels of a tile, and so the most work items of a tracing launch: below
+ * RENDER_LARGE_GRID, so that the first launches (renderer_first_launch) compile all a
+ * render runs. */
+#define RENDER_MAX_TILE (RENDER_LARGE_GRID - 64)
 
 /* Tiles bounded so that 32-bit work counters of one tile cannot overflow, and the ray
  * buffers for a tile (at least one pixel's deepest supersamples). Returns 0 or 1. */

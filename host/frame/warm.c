@@ -67,14 +67,6 @@ static int warm_one(int index, int p, int *how, char *err, size_t errlen)
     return rc;
 }
 
-static const char *warm_how(int how)
-{
-    return how == CLU_BUILT                ? "compiled"
-           : how == CLU_BINARY             ? "already built (vbcl's binary cache)"
-           : how == CLU_BUILT_DRIVER_CACHE ? "already built (the driver's cache)"
-                                           : "ready";
-}
-
 /* Worker w of `workers`: opens the devices spec names (OpenCL is started in each worker
  * process, never in the parent) and builds its share of the list (programs largest first,
  * then devices). Returns 0 or 1 (after a message). */
@@ -101,7 +93,7 @@ static int warm_worker(const char *spec, int w, int workers, int quiet)
                     features_program_name(p), d, err);
         else if (!quiet)
             fprintf(stderr, "vbcl: warm-cache: %s kernels on device %d: %s in %.1f s\n",
-                    features_program_name(p), d, warm_how(how), (clu_now_ms() - t0) * 1e-3);
+                    features_program_name(p), d, clu_build_how(how), (clu_now_ms() - t0) * 1e-3);
     }
     return rc;
 }
