@@ -454,14 +454,24 @@ static void print_build_log(VbDevice *d, cl_program prog, const char *options)
     }
 }
 
+static int driver_is_pocl(const VbDevice *d)
+{
+    char name[256] = "";
+    clGetPlatformInfo(d->platform, CL_PLATFORM_NAME, sizeof name, name, NULL);
+    return strstr(name, "Portable Computing Language") != NULL;
+}
+
+int clu_compiles_at_launch(const VbDevice *d)
+{
+    return driver_is_pocl(d);
+}
+
 /* Whether d's driver keeps compiled kernels of its own between runs: PoCL does, in
  * POCL_CACHE_DIR, unless POCL_KERNEL_CACHE is 0. */
 static int driver_caches_kernels(const VbDevice *d)
 {
-    char name[256] = "";
-    clGetPlatformInfo(d->platform, CL_PLATFORM_NAME, sizeof name, name, NULL);
     const char *off = getenv("POCL_KERNEL_CACHE");
-    return strstr(name, "Portable Computing Language") && !(off && !strcmp(off, "0"));
+    return driver_is_pocl(d) && !(off && !strcmp(off, "0"));
 }
 
 /* Whether vbcl keeps d's program binaries itself: VBCL_CACHE_BINARIES 1 always, 0 never;
