@@ -45,9 +45,9 @@ LIB_OBJ  := $(patsubst host/%.c,$(BUILD)/host/%.o,$(filter-out host/main.c $(PLU
             $(patsubst host/%.cpp,$(BUILD)/host/%.o,$(HOST_CXX)) $(BUILD)/kernel_source.o
 MAIN_OBJ := $(BUILD)/host/main.o
 # The vbcl binary: the library without OpenImageIO's file, the plugin's loader, and the
-# plugin (image_io.cpp, image_path.c, image_pfm.c and fileio.c as a shared object) embedded.
-PLUGIN_SRC := host/util/image_io.cpp host/util/image_path.c host/util/image_pfm.c \
-              host/util/fileio.c
+# plugin (image_io.cpp and image_path.c as a shared object, which encodes and reads images;
+# vbcl writes the files itself) embedded.
+PLUGIN_SRC := host/util/image_io.cpp host/util/image_path.c
 VBCL_OBJ := $(MAIN_OBJ) $(filter-out $(BUILD)/host/util/image_io.o,$(LIB_OBJ)) \
             $(BUILD)/host/util/image_plugin.o $(BUILD)/image_plugin_blob.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
@@ -114,6 +114,11 @@ $(BUILD)/vbcl-tests: $(TEST_OBJ) $(LIB_OBJ) $(BUILD)/probe_source.o
 	@echo "  LINK    $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
+# The fault-injection library of test_faults.c (LD_PRELOAD; tests/fault/shim.c).
+$(BUILD)/libvbcl_fault.so: tests/fault/shim.c
+	@echo "  LINK    $@"
+	$(Q)$(CC) $(CSTD) -O1 $(WARN) -shared -fPIC -o $@ $< -ldl
+
 $(BUILD)/host/%.o: host/%.c build/config.mk
 	@mkdir -p $(dir $@)
 	@echo "  CC      $<"
@@ -173,7 +178,8 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 # `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
 # mean nothing.
 test:
-	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays
+	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays \
+	    $(BUILD)/libvbcl_fault.so
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
@@ -300,7 +306,8 @@ fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
 	done
 
 FORMAT_FILES := $(wildcard host/*.c host/*.h host/*/*.c host/*/*.h host/*/*.cpp kernels/*.cl kernels/*.h tests/*.c tests/*.h \
-                tests/stress/*.c tests/bench/*.c tests/bench/*.h tests/fuzz/*.c tests/fuzz/*.h scripts/*.c)
+                tests/stress/*.c tests/bench/*.c tests/bench/*.h tests/fuzz/*.c tests/fuzz/*.h tests/fault/*.c \
+                scripts/*.c)
 format:
 	clang-format -i $(FORMAT_FILES)
 

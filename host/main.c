@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -122,7 +123,7 @@ static const char usage_text[] =
     "PoCL, which keeps compiled kernels in its own cache, POCL_CACHE_DIR, default\n"
     "~/.cache/pocl/kcache), VBCL_KERNEL_PROGRAMS (classes, the default; scene: a program\n"
     "of each scene's exact features, for comparison), VBCL_IMAGE_HELPER (0: load\n"
-    "OpenImageIO in vbcl itself rather than in a helper process that writes the PNG,\n"
+    "OpenImageIO in vbcl itself rather than in a helper process that encodes the PNG,\n"
     "JPEG, TIFF or EXR); to clear the compiled kernels remove both cache folders\n"
     "mpirun -np N vbcl SCENE.json ...: the ranks share a still image's tiles, and an\n"
     "animation's frames (frame by frame in tiles with --stats-json); docs/scaling.md\n"
@@ -864,6 +865,9 @@ static int run(Dist *d, int argc, char **argv, double t0)
 
 int main(int argc, char **argv)
 {
+    /* A file-size limit (ulimit -f) then fails the write with "File too large", which
+     * fileio.c reports with the file's name, instead of killing the process mid-write. */
+    signal(SIGXFSZ, SIG_IGN);
     if (argc > 1 && strcmp(argv[1], "texgen") == 0) return texgen_main(argc - 1, argv + 1);
     if (argc == 2 && strcmp(argv[1], "--image-helper") == 0) return image_helper_main();
     double t0 = clu_now_ms();

@@ -109,7 +109,7 @@ static long ld_debug_pid(const char *out, const char *what)
 
 /* vbcl loads OpenImageIO only to read or write an image, from the plugin embedded in it
  * (host/util/image_plugin.c): the binary does not link it, --help does not load it, and a
- * render has its PNG written by the helper process that loads it (another pid in the
+ * render has its PNG encoded by the helper process that loads it (another pid in the
  * dynamic loader's log), or by itself with VBCL_IMAGE_HELPER=0, the same bytes; the
  * helper is no option of the command line. */
 static void test_cli_image_plugin(void)

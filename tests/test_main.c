@@ -110,5 +110,6 @@ int main(int argc, char **argv)
     suite_dispersion();
     suite_structure();
     suite_scale();
+    suite_faults();
     return th_summary();
 }

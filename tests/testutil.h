@@ -38,5 +38,6 @@ void suite_aa(void);
 void suite_dispersion(void);
 void suite_structure(void);
 void suite_scale(void);
+void suite_faults(void);
 
 #endif

@@ -1,51 +1,148 @@
-/* fileio.c — files written whole or not at all (temporary file + rename). */
+/* fileio.c — files written whole or not at all: a temporary file beside the target, every
+ * write checked, flushed and synced, closed with its result checked, then renamed into
+ * place; a failure or a fatal signal during the write removes the temporary. */
 #include "fileio.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-/* The temporary name for path: ".NAME.tmpPID" beside it. Returns 0, or -1 if too long. */
-static int temp_name(const char *path, char *tmp, size_t n)
+/* The temporaries being written now, for the signal handler: a slot is live while its
+ * file exists under its name (writes from several threads each hold one). */
+#define TEMP_SLOTS 16
+static struct {
+    char path[4200];
+    volatile sig_atomic_t live;
+} temps[TEMP_SLOTS];
+static pthread_mutex_t temps_lock = PTHREAD_MUTEX_INITIALIZER;
+static unsigned temps_serial; /* tells apart the temporaries of one process */
+
+/* The signals that remove the temporaries, and the action each had before (a handler of
+ * a library, such as LLVM's in an OpenCL compiler, or the default). */
+static const int temps_sigs[] = {SIGINT, SIGTERM, SIGHUP};
+static struct sigaction temps_old[3];
+
+/* Removes the live temporaries, then gives the signal to the action it had before (which
+ * kills the process for the default), once this handler returns (async-signal-safe:
+ * unlink, sigaction, raise). */
+static void temps_on_signal(int sig)
+{
+    for (int i = 0; i < TEMP_SLOTS; i++)
+        if (temps[i].live) unlink(temps[i].path);
+    for (int i = 0; i < 3; i++)
+        if (temps_sigs[i] == sig) sigaction(sig, &temps_old[i], NULL);
+    raise(sig);
+}
+
+/* Installs the handler once for each of the three signals that are not ignored (under
+ * nohup SIGHUP stays ignored). Called with temps_lock held. */
+static void temps_install(void)
+{
+    static int done;
+    if (done) return;
+    done = 1;
+    for (int i = 0; i < 3; i++) {
+        if (sigaction(temps_sigs[i], NULL, &temps_old[i]) ||
+            (!(temps_old[i].sa_flags & SA_SIGINFO) && temps_old[i].sa_handler == SIG_IGN))
+            continue;
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = temps_on_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(temps_sigs[i], &sa, NULL);
+    }
+}
+
+/* Takes a slot and names the temporary for path in it: ".NAME.tmpPID.N" beside path.
+ * Returns the slot, or -1 with a message in err (path too long, or every slot taken). */
+static int temp_begin(const char *path, char *err, size_t errlen)
 {
     const char *slash = strrchr(path, '/');
     int dirlen = slash ? (int)(slash - path + 1) : 0;
-    int k = snprintf(tmp, n, "%.*s.%s.tmp%ld", dirlen, path, path + dirlen, (long)getpid());
-    return k < 0 || (size_t)k >= n ? -1 : 0;
+    pthread_mutex_lock(&temps_lock);
+    temps_install();
+    int slot = -1;
+    for (int i = 0; i < TEMP_SLOTS && slot < 0; i++)
+        if (!temps[i].live) slot = i;
+    if (slot >= 0) {
+        int k = snprintf(temps[slot].path, sizeof temps[slot].path, "%.*s.%s.tmp%ld.%u", dirlen,
+                         path, path + dirlen, (long)getpid(), temps_serial++);
+        if (k < 0 || (size_t)k >= sizeof temps[slot].path) {
+            snprintf(err, errlen, "%s: path too long", path);
+            slot = -1;
+        } else
+            temps[slot].live = 1; /* before the file exists: a signal then unlinks nothing */
+    } else
+        snprintf(err, errlen, "%s: cannot write: too many files being written at once", path);
+    pthread_mutex_unlock(&temps_lock);
+    return slot;
+}
+
+/* Removes the slot's temporary (unless it was renamed: keep) and frees the slot. */
+static void temp_end(int slot, int keep)
+{
+    if (!keep) unlink(temps[slot].path);
+    pthread_mutex_lock(&temps_lock);
+    temps[slot].live = 0;
+    pthread_mutex_unlock(&temps_lock);
+}
+
+/* Makes the rename of a file in path's directory durable (best effort: some filesystems
+ * cannot sync a directory). */
+static void sync_dir(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else
+        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        fsync(fd);
+        close(fd);
+    }
 }
 
 int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
                       char *err, size_t errlen)
 {
-    char tmp[4200];
-    if (temp_name(path, tmp, sizeof tmp)) {
-        snprintf(err, errlen, "%s: path too long", path);
-        return -1;
+    int slot = temp_begin(path, err, errlen);
+    if (slot < 0) return -1;
+    const char *tmp = temps[slot].path;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno == EEXIST) { /* left by a killed process of the same id */
+        unlink(tmp);
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     }
-    FILE *f = fopen(tmp, "wb");
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
     if (!f) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+        int e = errno;
+        if (fd >= 0) close(fd);
+        temp_end(slot, 0);
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(e));
         return -1;
     }
     errno = 0;
     write(f, ctx);
-    int ok = !ferror(f);
-    int saved = errno;
-    if (fclose(f) != 0 && ok) {
-        ok = 0;
-        saved = errno;
-    }
-    if (ok && rename(tmp, path) != 0) {
-        ok = 0;
-        saved = errno;
-    }
-    if (!ok) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(saved ? saved : EIO));
-        remove(tmp);
+    /* The first error wins: a short write, the flush of what is buffered, the sync to
+     * the disk (where a full disk or quota may show only now), the close. */
+    int saved = ferror(f) ? (errno ? errno : EIO) : 0;
+    if (!saved && fflush(f) != 0) saved = errno ? errno : EIO;
+    if (!saved && fsync(fileno(f)) != 0 && errno != EINVAL) saved = errno;
+    if (fclose(f) != 0 && !saved) saved = errno ? errno : EIO;
+    if (!saved && rename(tmp, path) != 0) saved = errno;
+    temp_end(slot, !saved);
+    if (saved) {
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(saved));
         return -1;
     }
+    sync_dir(path);
     return 0;
 }
 

@@ -1,20 +1,22 @@
 /* fileio.h — files written whole or not at all: the bytes go to a temporary file in the
- * target's directory, which is renamed into place once complete. */
+ * target's directory, which is renamed into place once complete and on the disk. */
 #ifndef VBCL_FILEIO_H
 #define VBCL_FILEIO_H
 
 #include <stddef.h>
 #include <stdio.h>
 
-/* Writes path whole or not at all: write(f, ctx) fills a temporary file (".NAME.tmpPID" in
- * path's directory; a write error shows in ferror(f)), which is renamed into place once
- * complete. Returns 0, or -1 with a message in err (no temporary file is left behind). */
+/* Writes path whole or not at all: write(f, ctx) fills a temporary file (".NAME.tmpPID.N"
+ * in path's directory; a write error shows in ferror(f)), which is flushed, synced to the
+ * disk, closed and renamed into place, each step checked. Returns 0, or -1 with a message
+ * naming path and the cause in err ("No space left on device", "File too large"); then the
+ * temporary is gone and an older file at path is untouched. SIGINT, SIGTERM and SIGHUP
+ * during the write remove the temporary before the process dies of them (the handler is
+ * installed at the first write, where the signal's action is the default). */
 int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
                       char *err, size_t errlen);
 
-/* Writes the n bytes at data to path under a temporary name (".NAME.tmpPID" in path's
- * directory) and renames it into place, so that path is only ever replaced by a complete
- * file. Returns 0, or -1 with a message in err (no temporary file is left behind). */
+/* Writes the n bytes at data to path as file_write_stream does. */
 int file_write_whole(const char *path, const void *data, size_t n, char *err, size_t errlen);
 
 /* Returns 0 when path's directory exists and is writable (a check before long work whose

@@ -1,7 +1,9 @@
-// image_io.cpp — the one C++ file: OpenImageIO behind the C interface of image_io.h. The
-// vbcl binary loads it as a plugin (image_plugin.c); the tests and tools link it.
+// image_io.cpp — the one C++ file: OpenImageIO behind the C interface of image_io.h
+// (image_encode, image_read). The vbcl binary loads it as a plugin (image_plugin.c); the
+// tests and tools link it.
 #include "image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
@@ -9,8 +11,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 using namespace OIIO;
@@ -22,30 +24,27 @@ static float srgb_encode(float v)
     return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
-extern "C" int image_write(const char *path, int width, int height, const float *rgba,
-                           float exposure, char *err, size_t errlen)
+extern "C" int image_encode(const char *path, int width, int height, const float *rgba,
+                            float exposure, unsigned char **bytes, size_t *nbytes, char *err,
+                            size_t errlen)
 {
+    *bytes = nullptr;
+    *nbytes = 0;
     if (image_check_path(path, err, errlen)) return -1;
-    if (image_is_native_format(path))
-        return image_write_pfm(path, width, height, rgba, exposure, err, errlen);
-    const char *dot = std::strrchr(path, '.'); // image_check_path found an extension
-    std::string e(dot + 1);
-    for (auto &ch : e) ch = (char)std::tolower((unsigned char)ch);
-    std::string p(path);
-    size_t slash = p.rfind('/');
-    std::string dir = slash == std::string::npos ? "" : p.substr(0, slash + 1);
-    std::string base = slash == std::string::npos ? p : p.substr(slash + 1);
-    std::string tmp = dir + "." + base + ".tmp" + std::to_string((long)getpid()) + "." + e;
-
     const float scale = std::exp2(exposure);
     const size_t n = (size_t)width * (size_t)height;
     bool flt = image_is_float_format(path) != 0;
     std::vector<float> fpix;
     std::vector<unsigned char> bpix;
-    if (flt)
-        fpix.resize(n * 3);
-    else
-        bpix.resize(n * 3);
+    try {
+        if (flt)
+            fpix.resize(n * 3);
+        else
+            bpix.resize(n * 3);
+    } catch (const std::bad_alloc &) {
+        std::snprintf(err, errlen, "%s: out of memory for a %dx%d image", path, width, height);
+        return -1;
+    }
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
             float v = rgba[4 * i + c] * scale;
@@ -55,39 +54,44 @@ extern "C" int image_write(const char *path, int width, int height, const float 
                 bpix[3 * i + c] = (unsigned char)std::lround(srgb_encode(v) * 255.0f);
         }
 
-    auto out = ImageOutput::create(tmp);
-    if (!out) {
+    // The writer is chosen by path's extension and writes into memory (an I/O proxy), never
+    // to path: the caller writes the bytes (fileio.h), checking every write.
+    auto out = ImageOutput::create(path);
+    if (!out || !out->supports("ioproxy")) {
         std::snprintf(err, errlen, "%s: cannot create a writer: %s", path,
-                      OIIO::geterror().c_str());
+                      out ? "it cannot write into memory" : OIIO::geterror().c_str());
         return -1;
     }
+    std::vector<unsigned char> buf;
+    Filesystem::IOVecOutput proxy(buf);
+    void *proxy_ptr = &proxy;
     ImageSpec spec(width, height, 3, flt ? TypeDesc::FLOAT : TypeDesc::UINT8);
-    if (!flt)
-        spec.attribute("oiio:ColorSpace", "sRGB");
-    else
-        spec.attribute("oiio:ColorSpace", "Linear");
+    spec.attribute("oiio:ColorSpace", flt ? "Linear" : "sRGB");
     spec.attribute("Software", "vbcl");
-    bool ok = out->open(tmp, spec);
+    spec.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy_ptr);
+    // TIFF's Exif directory cannot go through a proxy (OpenImageIO 2.4: "failed
+    // TIFFWriteCustomDirectory() of the Exif data", and a file cut short), and vbcl has no
+    // Exif data to write.
+    spec.attribute("tiff:write_exif", 0);
+    bool ok = out->open(path, spec);
     if (ok)
         ok = flt ? out->write_image(TypeDesc::FLOAT, fpix.data())
                  : out->write_image(TypeDesc::UINT8, bpix.data());
     if (ok) ok = out->close();
-    if (!ok) {
-        std::string msg = out->geterror();
-        for (size_t at; (at = msg.find(tmp)) != std::string::npos;) // the name the user gave
-            msg.replace(at, tmp.size(), path);
-        out.reset();
-        std::remove(tmp.c_str());
-        std::snprintf(err, errlen, "%s: cannot write: %s", path, msg.c_str());
+    // A writer may report an error and still return true: the image is not trusted then.
+    std::string msg = out->geterror();
+    if (!ok || !msg.empty() || buf.empty()) {
+        std::snprintf(err, errlen, "%s: cannot encode the image: %s", path,
+                      msg.empty() ? "the writer failed" : msg.c_str());
         return -1;
     }
-    out.reset();
-    if (std::rename(tmp.c_str(), path) != 0) {
-        std::snprintf(err, errlen, "%s: cannot rename the finished image into place: %s", path,
-                      std::strerror(errno));
-        std::remove(tmp.c_str());
+    *bytes = (unsigned char *)std::malloc(buf.size());
+    if (!*bytes) {
+        std::snprintf(err, errlen, "%s: out of memory for the encoded image", path);
         return -1;
     }
+    std::memcpy(*bytes, buf.data(), buf.size());
+    *nbytes = buf.size();
     return 0;
 }
 

@@ -25,7 +25,7 @@ int image_write_pfm(const char *path, int width, int height, const float *rgba, 
 
 /* Makes OpenImageIO ready for the image writes to come while the program goes on: in the
  * vbcl binary, which loads it as a plugin (image_plugin.c) rather than at start-up, by
- * starting the helper process that will write the images (`vbcl --image-helper`; once a
+ * starting the helper process that will encode the images (`vbcl --image-helper`; once a
  * run), or, where it cannot start and `thread` is set, by loading the plugin on a thread
  * of its own (vbcl asks for that once its devices are open: the dynamic loader serves one
  * thread at a time, and the OpenCL driver's own loading would wait for it). Only the vbcl
@@ -40,16 +40,26 @@ void image_preload(int thread);
 void image_preload_wait(void);
 
 /* The helper process's main (vbcl --image-helper, started by image_preload): loads the
- * plugin and writes the images vbcl sends it, until vbcl closes the socket. Returns the
- * exit status. */
+ * plugin and encodes the images vbcl sends it, sending back the bytes, until vbcl closes
+ * the socket. Returns the exit status. */
 int image_helper_main(void);
 
 /* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
- * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file
- * is written under a temporary name in the same directory and renamed into place, so an
- * existing file is replaced only by a complete image. Returns 0, or -1 with a message. */
+ * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The image is
+ * encoded in memory (image_encode; PFM by image_pfm.c) and written by this process through
+ * fileio.h: a temporary file in the same directory, every write checked, synced and
+ * renamed into place, so an existing file is replaced only by a complete image, and a
+ * failed write leaves no temporary. Returns 0, or -1 with a message naming path and the
+ * cause ("No space left on device"). */
 int image_write(const char *path, int width, int height, const float *rgba, float exposure,
                 char *err, size_t errlen);
+
+/* Encodes rgba as image_write would write it in path's format (PNG, JPEG, TIFF or EXR, by
+ * the extension) into memory: *bytes (malloc'ed) of *n bytes. Nothing is written; path
+ * names the image in messages. In the vbcl binary the encoding runs in the image helper
+ * process, or on the plugin loaded here (image_plugin.c). Returns 0, or -1 with a message. */
+int image_encode(const char *path, int width, int height, const float *rgba, float exposure,
+                 unsigned char **bytes, size_t *n, char *err, size_t errlen);
 
 /* Reads an image as floats, 4 channels per pixel (missing channels 0, alpha 1), values as
  * stored (8-bit images give encoded values in [0, 1]). *rgba is malloc'ed. */

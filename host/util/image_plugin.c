@@ -1,4 +1,4 @@
-/* image_plugin.c — image_write and image_read of the vbcl binary, by OpenImageIO loaded
+/* image_plugin.c — image_encode and image_read of the vbcl binary, by OpenImageIO loaded
  * as a plugin. Debian's OpenImageIO brings some 260 shared libraries, whose symbols the
  * dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render pays
  * before its first ray"); linked into vbcl, every run paid that before main, `--help`
@@ -6,10 +6,11 @@
  * (vbcl_image_plugin, Makefile), loaded from an anonymous memory file (memfd_create), or
  * from an unlinked temporary file where there is none, so that the binary stays one file.
  *
- * A render that writes such an image has it written by a helper process: image_preload
+ * A render that writes such an image has it encoded by a helper process: image_preload
  * starts vbcl again as `vbcl --image-helper` (image_helper_main), which loads the plugin
- * while this process opens its devices, builds its kernels and renders, and image_write
- * sends it the pixels.
+ * while this process opens its devices, builds its kernels and renders; image_encode sends
+ * it the pixels and gets back the file's bytes, which this process writes (image_write.c),
+ * so that the file's owner checks the write and removes its temporary.
  * Loaded on a thread of this process instead, the plugin held up the kernels' build from
  * source for as long as it loaded (the dynamic loader serves one thread at a time:
  * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
@@ -38,14 +39,15 @@ extern char **environ;
 /* The plugin's bytes (image_plugin_blob.o, which the Makefile makes). */
 extern const unsigned char vbcl_image_plugin[], vbcl_image_plugin_end[];
 
-typedef int (*WriteFn)(const char *, int, int, const float *, float, char *, size_t);
+typedef int (*EncodeFn)(const char *, int, int, const float *, float, unsigned char **, size_t *,
+                        char *, size_t);
 typedef int (*ReadFn)(const char *, int *, int *, float **, char *, size_t);
 
 static pthread_mutex_t plugin_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t plugin_loaded = PTHREAD_COND_INITIALIZER;
 static struct {
     int state; /* PLUGIN_NONE, _LOADING (on the preload thread) or _DONE (tried) */
-    WriteFn write;
+    EncodeFn encode;
     ReadFn read;
     char err[512]; /* why it failed */
 } plugin;
@@ -98,11 +100,11 @@ static void plugin_load(void)
         snprintf(plugin.err, sizeof plugin.err, "%s", dlerror());
         return;
     }
-    plugin.write = (WriteFn)dlsym(h, "image_write");
+    plugin.encode = (EncodeFn)dlsym(h, "image_encode");
     plugin.read = (ReadFn)dlsym(h, "image_read");
-    if (!plugin.write || !plugin.read) {
+    if (!plugin.encode || !plugin.read) {
         snprintf(plugin.err, sizeof plugin.err, "its functions are missing");
-        plugin.write = NULL;
+        plugin.encode = NULL;
         plugin.read = NULL;
     }
 }
@@ -150,8 +152,9 @@ static struct {
     int tried; /* helper_start was called: one helper a run */
 } helper = {0, -1, 0};
 
-/* A write request: the header, then path_len bytes of path, then width * height * 4 floats.
- * The reply: rc (0 or -1), then err_len bytes of message. */
+/* An encoding request: the header, then path_len bytes of path (whose extension names the
+ * format), then width * height * 4 floats. The reply: rc (0 or -1), then err_len bytes of
+ * message and bytes bytes of the encoded image. */
 typedef struct {
     uint32_t magic;
     int32_t width, height;
@@ -161,6 +164,7 @@ typedef struct {
 typedef struct {
     int32_t rc;
     uint32_t err_len;
+    uint64_t bytes;
 } HelperReply;
 
 /* Sends or receives all n bytes; 0, or -1 on an error or the other end gone. */
@@ -226,10 +230,10 @@ void image_preload(int thread)
     if (!started && thread) preload_thread();
 }
 
-/* image_write through the helper: 0, -1 with its message, or -2 when there is no helper
- * or it is gone (then the caller writes here). */
-static int helper_write(const char *path, int width, int height, const float *rgba, float exposure,
-                        char *err, size_t errlen)
+/* image_encode through the helper: 0, -1 with its message, or -2 when there is no helper
+ * or it is gone (then the caller encodes here). */
+static int helper_encode(const char *path, int width, int height, const float *rgba, float exposure,
+                         unsigned char **out, size_t *nout, char *err, size_t errlen)
 {
     pthread_mutex_lock(&helper_lock);
     int rc = -2;
@@ -239,22 +243,33 @@ static int helper_write(const char *path, int width, int height, const float *rg
     if (helper.fd >= 0 && !sock_all(helper.fd, &q, sizeof q, 1) &&
         !sock_all(helper.fd, (void *)path, plen, 1) &&
         !sock_all(helper.fd, (void *)rgba, bytes, 1) && !sock_all(helper.fd, &a, sizeof a, 0) &&
-        a.err_len < 4096) {
+        a.err_len < 4096 && a.bytes <= SIZE_MAX) {
         char msg[4096];
-        if (!sock_all(helper.fd, msg, a.err_len, 0)) {
+        unsigned char *data = a.bytes ? malloc((size_t)a.bytes) : NULL;
+        if (a.bytes && !data) {
+            snprintf(err, errlen, "%s: out of memory for the encoded image (%llu bytes)", path,
+                     (unsigned long long)a.bytes);
+            rc = -1;
+            helper.fd = (close(helper.fd), -1); /* its reply cannot be read: end it */
+        } else if (!sock_all(helper.fd, msg, a.err_len, 0) &&
+                   !sock_all(helper.fd, data, (size_t)a.bytes, 0)) {
             msg[a.err_len] = 0;
             if (a.rc) snprintf(err, errlen, "%s", msg);
             rc = a.rc ? -1 : 0;
+            *out = data;
+            *nout = (size_t)a.bytes;
+            data = NULL;
         }
+        free(data);
     }
     pthread_mutex_unlock(&helper_lock);
     if (rc == -2) helper_stop(); /* gone: not asked again */
     return rc;
 }
 
-/* `vbcl --image-helper`: loads the plugin, then writes each image the socket on
- * HELPER_FD asks for and answers with image_write's result, until the socket closes.
- * A request cut short (vbcl gone) writes nothing. */
+/* `vbcl --image-helper`: loads the plugin, then encodes each image the socket on
+ * HELPER_FD asks for and answers with image_encode's result and bytes, until the socket
+ * closes. It writes no file: vbcl does (image_write.c). */
 int image_helper_main(void)
 {
     HelperRequest q;
@@ -277,13 +292,18 @@ int image_helper_main(void)
             return 1;
         }
         path[q.path_len] = 0;
-        int rc = plugin.write
-                     ? plugin.write(path, q.width, q.height, rgba, q.exposure, err, sizeof err)
-                     : plugin_missing(path, err, sizeof err);
+        unsigned char *data = NULL;
+        size_t n = 0;
+        int rc = plugin.encode ? plugin.encode(path, q.width, q.height, rgba, q.exposure, &data, &n,
+                                               err, sizeof err)
+                               : plugin_missing(path, err, sizeof err);
         free(rgba);
-        HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u};
-        if (sock_all(HELPER_FD, &a, sizeof a, 1) || sock_all(HELPER_FD, err, a.err_len, 1))
-            return 1;
+        HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u, rc ? 0u : (uint64_t)n};
+        int sent = !sock_all(HELPER_FD, &a, sizeof a, 1) &&
+                   !sock_all(HELPER_FD, err, a.err_len, 1) &&
+                   !sock_all(HELPER_FD, data, (size_t)a.bytes, 1);
+        free(data);
+        if (!sent) return 1;
     }
     return 0;
 }
@@ -305,26 +325,25 @@ static int plugin_ready(const char *path, char *err, size_t errlen)
         plugin.state = PLUGIN_DONE;
     }
     while (plugin.state != PLUGIN_DONE) pthread_cond_wait(&plugin_loaded, &plugin_lock);
-    int ok = plugin.write != NULL;
+    int ok = plugin.encode != NULL;
     pthread_mutex_unlock(&plugin_lock);
     return ok ? 0 : plugin_missing(path, err, errlen);
 }
 
-int image_write(const char *path, int width, int height, const float *rgba, float exposure,
-                char *err, size_t errlen)
+int image_encode(const char *path, int width, int height, const float *rgba, float exposure,
+                 unsigned char **bytes, size_t *n, char *err, size_t errlen)
 {
-    if (image_check_path(path, err, errlen)) return -1;
-    if (image_is_native_format(path))
-        return image_write_pfm(path, width, height, rgba, exposure, err, errlen);
+    *bytes = NULL;
+    *n = 0;
     pthread_mutex_lock(&plugin_lock);
     int here = plugin.state != PLUGIN_NONE; /* loaded, or loading, in this process */
     pthread_mutex_unlock(&plugin_lock);
     if (!here) {
-        int rc = helper_write(path, width, height, rgba, exposure, err, errlen);
+        int rc = helper_encode(path, width, height, rgba, exposure, bytes, n, err, errlen);
         if (rc != -2) return rc;
     }
     if (plugin_ready(path, err, errlen)) return -1;
-    return plugin.write(path, width, height, rgba, exposure, err, errlen);
+    return plugin.encode(path, width, height, rgba, exposure, bytes, n, err, errlen);
 }
 
 int image_read(const char *path, int *width, int *height, float **rgba, char *err, size_t errlen)

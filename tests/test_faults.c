@@ -1,0 +1,243 @@
+/* test_faults.c — faults while vbcl writes its outputs: a file-size limit, a full disk, a
+ * failing sync, a signal during the write. Each must leave an older file at the path as it
+ * was and no temporary beside it, exit non-zero, and name the file and the cause
+ * (docs/testing.md, "Faults"). */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "testutil.h"
+
+#define FAULT_SCENE                                                                                \
+    "{\"image\": {\"width\": 96, \"height\": 96},\n"                                               \
+    " \"camera\": {\"eye\": [0, 1, 5], \"look_at\": [0, 0, 0]},\n"                                 \
+    " \"lights\": [{\"centre\": [2, 4, 3], \"radius\": 0.5, \"flux\": 500}],\n"                    \
+    " \"materials\": {\"m\": {\"diffuse\": [0.8, 0.3, 0.2]}},\n"                                   \
+    " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}]}\n"
+
+/* The old file every case puts at the path first: it must be there, the same, after. */
+#define OLD_TEXT "an older output, kept whole\n"
+
+/* Whether dir holds a file whose name contains part. */
+static int dir_has(const char *dir, const char *part)
+{
+    DIR *d = opendir(dir);
+    int found = 0;
+    for (struct dirent *e; d && (e = readdir(d));) found |= strstr(e->d_name, part) != NULL;
+    if (d) closedir(d);
+    return found;
+}
+
+/* Puts OLD_TEXT at path. */
+static void put_old(const char *path)
+{
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs(OLD_TEXT, f);
+        fclose(f);
+    }
+}
+
+/* Whether path still holds OLD_TEXT, whole. */
+static int old_intact(const char *path)
+{
+    char buf[256] = "";
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    return strcmp(buf, OLD_TEXT) == 0;
+}
+
+/* A directory of its own under the test directory (made empty). */
+static const char *fault_dir(const char *name)
+{
+    static char dir[4][512];
+    static int next;
+    char *d = dir[next++ % 4];
+    snprintf(d, sizeof dir[0], "%s/%s", tu_tmpdir(), name);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", d, d);
+    tu_run(cmd, NULL, 0);
+    return d;
+}
+
+/* The outputs each case writes over an old file: the image in every format vbcl writes,
+ * and the --stats-json document (with an 8 x 8 PFM image, which fits every limit here). */
+static const char *const outputs[] = {"png", "exr", "tif", "jpg", "pfm", "json"};
+
+/* vbcl's arguments writing the output of kind ext to dir/out.EXT. */
+static void output_args(const char *scene, const char *dir, const char *ext, char *args, size_t n)
+{
+    if (!strcmp(ext, "json"))
+        snprintf(args, n, "%s -q --width 8 --height 8 -o %s/img.pfm --stats-json %s/out.json",
+                 scene, dir, dir);
+    else
+        snprintf(args, n, "%s -q -o %s/out.%s", scene, dir, ext);
+}
+
+/* A limit on the size of files (ulimit -f 4096: 4 MiB, which the OpenCL compiler's own
+ * files fit): a 640 x 640 PFM (4.9 MB) fails with EFBIG. vbcl must not die of SIGXFSZ
+ * mid-write (vbcl texgen did, writing its PNG through OpenImageIO). */
+static void test_faults_file_size_limit(void)
+{
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("fsize");
+    char args[2048], cmd[4096], out[4096], path[1024];
+    snprintf(path, sizeof path, "%s/out.pfm", dir);
+    snprintf(args, sizeof args, "%s -q --width 640 --height 640 -o %s", scene, path);
+    snprintf(cmd, sizeof cmd, "%s %s", tu_vbcl, args); /* unlimited first: the caches warm */
+    CHECK(tu_run(cmd, out, sizeof out) == 0, "without a limit: %s", out);
+    put_old(path);
+    snprintf(cmd, sizeof cmd, "bash -c 'ulimit -f 4096; exec %s %s'", tu_vbcl, args);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, path) && strstr(out, "File too large"),
+          "over the file-size limit: exit 1 naming the file and the cause (%d): %s", rc, out);
+    CHECK(old_intact(path), "the older file is intact");
+    CHECK(!dir_has(dir, ".tmp"), "no temporary left");
+    /* vbcl texgen opens no OpenCL device: a limit of 8 KiB, and its images (every format,
+     * 15 - 210 KB at 256 x 256) and meshes (440 KB) */
+    static const char *const texgen[] = {
+        "fourier --pixels 256 -o %s/tex.png", "fourier --pixels 256 -o %s/tex.exr",
+        "fourier --pixels 256 -o %s/tex.tif", "fourier --pixels 256 -o %s/tex.jpg",
+        "bomb --count 20 -o %s/tex.obj",      "bomb --count 20 -o %s/tex.ply"};
+    for (size_t i = 0; i < sizeof texgen / sizeof texgen[0]; i++) {
+        char targs[1024];
+        snprintf(targs, sizeof targs, texgen[i], dir);
+        snprintf(path, sizeof path, "%s", strstr(targs, "-o ") + 3);
+        put_old(path);
+        snprintf(cmd, sizeof cmd, "bash -c 'ulimit -f 8; exec %s texgen %s'", tu_vbcl, targs);
+        rc = tu_run(cmd, out, sizeof out);
+        CHECK(rc == 1 && strstr(out, path) && strstr(out, "File too large"),
+              "texgen %s over the limit: exit 1 naming the file and the cause (%d): %s", targs, rc,
+              out);
+        CHECK(old_intact(path), "texgen %s: the older file is intact", targs);
+        CHECK(!dir_has(dir, ".tmp"), "texgen %s: no temporary left", targs);
+    }
+}
+
+/* A full disk: a 64 KiB tmpfs (where this machine lets the tests mount one), holding an
+ * old file. Every image format fails with ENOSPC, exit 1, the old file whole. */
+static void test_faults_full_disk(void)
+{
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("full");
+    char cmd[4096], out[4096], args[2048], path[1024];
+    snprintf(cmd, sizeof cmd, "mount -t tmpfs -o size=64k vbcl-test-full '%s'", dir);
+    if (tu_run(cmd, out, sizeof out) != 0) {
+        th_skip("cannot mount a small tmpfs here (needs root and CAP_SYS_ADMIN)");
+        return;
+    }
+    for (size_t i = 0; i < 4; i++) { /* the old files, then the disk filled to the last byte */
+        snprintf(path, sizeof path, "%s/out.%s", dir, outputs[i]);
+        put_old(path);
+    }
+    snprintf(cmd, sizeof cmd, "cat /dev/zero > '%s/filler'", dir);
+    tu_run(cmd, NULL, 0);
+    for (size_t i = 0; i < 4; i++) { /* png, exr, tif, jpg */
+        const char *ext = outputs[i];
+        snprintf(path, sizeof path, "%s/out.%s", dir, ext);
+        snprintf(args, sizeof args, "%s --width 160 --height 160", scene);
+        snprintf(cmd, sizeof cmd, "%s %s -q -o %s", tu_vbcl, args, path);
+        int rc = tu_run(cmd, out, sizeof out);
+        CHECK(rc == 1 && strstr(out, path) && strstr(out, "No space left on device"),
+              "%s on a full disk: exit 1 naming the file and the cause (%d): %s", ext, rc, out);
+        CHECK(old_intact(path), "%s: the older file is intact", ext);
+        CHECK(!dir_has(dir, ".tmp"), "%s: no temporary left", ext);
+    }
+    snprintf(cmd, sizeof cmd, "umount '%s'", dir);
+    tu_run(cmd, NULL, 0);
+}
+
+/* The shim's path (build/libvbcl_fault.so beside the vbcl under test). */
+static const char *shim_path(void)
+{
+    static char path[1024];
+    const char *slash = strrchr(tu_vbcl, '/');
+    snprintf(path, sizeof path, "%.*slibvbcl_fault.so", slash ? (int)(slash - tu_vbcl + 1) : 0,
+             tu_vbcl);
+    return path;
+}
+
+/* Runs vbcl with args under the fault shim (fault on files whose path holds part), with
+ * the three signals' default actions (a background job starts with SIGINT ignored);
+ * returns the exit status (128 + N for signal N). ASan may not come first under it. */
+static int run_faulty(const char *fault, const char *part, const char *args, char *out, size_t n)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "exec env --default-signal=INT,TERM,HUP LD_PRELOAD=%s VBCL_FAULT=%s "
+             "VBCL_FAULT_PATH=%s "
+             "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}verify_asan_link_order=0\" %s %s",
+             shim_path(), fault, part, tu_vbcl, args);
+    return tu_run(cmd, out, n);
+}
+
+/* The sync before the rename fails (an I/O error, or a quota or full disk that shows only
+ * there): exit 1 with the cause, for every output. */
+static void test_faults_sync_fails(void)
+{
+    if (access(shim_path(), R_OK)) {
+        CHECK(0, "the fault shim %s is missing (make builds it with the tests)", shim_path());
+        return;
+    }
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("sync");
+    char args[2048], out[4096], path[1024];
+    for (size_t i = 0; i < sizeof outputs / sizeof outputs[0]; i++) {
+        const char *ext = outputs[i];
+        output_args(scene, dir, ext, args, sizeof args);
+        snprintf(path, sizeof path, "%s/out.%s", dir, ext);
+        put_old(path);
+        const char *fault = i % 2 ? "ENOSPC" : "EIO";
+        int rc = run_faulty(fault, ".out.", args, out, sizeof out);
+        const char *cause = i % 2 ? "No space left on device" : "Input/output error";
+        CHECK(rc == 1 && strstr(out, path) && strstr(out, cause),
+              "%s, %s at the sync: exit 1 naming the file and the cause (%d): %s", ext, fault, rc,
+              out);
+        CHECK(old_intact(path), "%s: the older file is intact", ext);
+        CHECK(!dir_has(dir, ".tmp"), "%s: no temporary left", ext);
+    }
+}
+
+/* SIGTERM, SIGINT and SIGHUP during the write: vbcl dies of the signal, the temporary is
+ * removed, the older file is whole. */
+static void test_faults_signal_in_write(void)
+{
+    if (access(shim_path(), R_OK)) {
+        CHECK(0, "the fault shim %s is missing (make builds it with the tests)", shim_path());
+        return;
+    }
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("signal");
+    static const struct {
+        const char *name;
+        int sig;
+        const char *ext;
+    } cases[] = {{"TERM", SIGTERM, "png"}, {"INT", SIGINT, "exr"}, {"HUP", SIGHUP, "json"}};
+    char args[2048], out[4096], path[1024];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        output_args(scene, dir, cases[i].ext, args, sizeof args);
+        snprintf(path, sizeof path, "%s/out.%s", dir, cases[i].ext);
+        put_old(path);
+        int rc = run_faulty(cases[i].name, ".out.", args, out, sizeof out);
+        CHECK(rc == 128 + cases[i].sig, "SIG%s in the write of %s: died of it (%d): %s",
+              cases[i].name, cases[i].ext, rc, out);
+        CHECK(old_intact(path), "SIG%s: the older file is intact", cases[i].name);
+        CHECK(!dir_has(dir, ".tmp"), "SIG%s: no temporary left", cases[i].name);
+    }
+}
+
+void suite_faults(void)
+{
+    RUN_TEST(test_faults_file_size_limit);
+    RUN_TEST(test_faults_full_disk);
+    RUN_TEST(test_faults_sync_fails);
+    RUN_TEST(test_faults_signal_in_write);
+}
