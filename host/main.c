@@ -491,6 +491,12 @@ static int apply_options(const Options *o, Scene *s)
                            o->aa_map ? "--aa-map" : "--aa-samples-map");
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
+    if (s->min_weight == 0.0f && s->max_depth > SCENE_UNPRUNED_MAX_DEPTH)
+        return usage_error("max_depth %d with min_weight 0 (render.max_depth and "
+                           "render.min_weight, or --depth and --min-weight): a ray tree that is "
+                           "never pruned can hold 2^%d rays per sample; give min_weight > 0 (the "
+                           "default is 0.001) or max_depth <= %d",
+                           s->max_depth, s->max_depth, SCENE_UNPRUNED_MAX_DEPTH);
     if (o->grid && scene_parse_grid_levels(o->grid, s->grid_res, s->subgrid_res))
         return usage_error("--grid %s: expected TOP or TOP:SUB, each auto, N or NX,NY,NZ (TOP "
                            "1..1024 each, at most 2^27 = 134217728 cells in all; SUB 1..64 each)",
@@ -813,8 +819,7 @@ static int render_all(const Options *o, Dist *d, const char *text, int first, in
 static int warm_main(const Options *o)
 {
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    const char *spec = o->device ? o->device : getenv("VBCL_DEVICE");
-    return warm_cache(spec, cores > 0 ? (int)cores : 1, o->quiet);
+    return warm_cache(o->device, cores > 0 ? (int)cores : 1, o->quiet);
 }
 
 /* The command line on this rank: the scene read and checked by rank 0 (once: it may be a
@@ -845,8 +850,7 @@ static int run(Dist *d, int argc, char **argv, double t0)
                  && needs_image_library(&o, have_still ? &still : NULL);
     if (writes) image_preload(0); /* the helper process, at once: a loader of its own */
     if (!rc) {
-        const char *spec = o.device ? o.device : getenv("VBCL_DEVICE");
-        rc = clu_devices_open(spec, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
+        rc = clu_devices_open(o.device, devs, CLU_MAX_DEVICES, &ndev, err, sizeof err);
         if (rc)
             diag_print(prog, "%s", err);
         else if (writes)

@@ -1,7 +1,7 @@
 /* test_faults.c — faults while vbcl writes its outputs: a file-size limit, a full disk, a
  * failing sync, a signal during the write. Each must leave an older file at the path as it
- * was and no temporary beside it, exit non-zero, and name the file and the cause
- * (docs/testing.md, "Faults"). */
+ * was and no temporary beside it, exit non-zero, and name the file and the cause. And a
+ * damaged cache entry, which must be named and made again (docs/testing.md, "Faults"). */
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "image_io.h"
 #include "testutil.h"
 
 #define FAULT_SCENE                                                                                \
@@ -234,10 +235,177 @@ static void test_faults_signal_in_write(void)
     }
 }
 
+/* A scene whose glass sphere holds a generated texture, cached under VBCL_CACHE_DIR. */
+#define TEXTURE_SCENE                                                                              \
+    "{\"image\": {\"width\": 32, \"height\": 32},\n"                                               \
+    " \"camera\": {\"eye\": [0, 0, 4], \"look_at\": [0, 0, 0]},\n"                                 \
+    " \"lights\": [{\"centre\": [2, 4, 3], \"radius\": 0.5, \"flux\": 500}],\n"                    \
+    " \"materials\": {\"glass\": {\"k_local\": 0.1, \"k_global\": 0.9, \"eta\": 1.5},\n"           \
+    "                \"red\": {\"diffuse\": [0.9, 0.1, 0.1]}},\n"                                  \
+    " \"objects\": [{\"shape\": \"sphere\", \"material\": \"glass\", \"texture\":\n"               \
+    "   {\"generate\": \"bomb --count 6 --size 12:24 --seed 3 --no-overlap --level 1\",\n"         \
+    "    \"material\": \"red\"}}]}\n"
+
+/* The one cached texture in cache/textures (its path in out), or -1. */
+static int cached_texture(const char *cache, char *out, size_t n)
+{
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/textures", cache);
+    DIR *d = opendir(dir);
+    int found = -1;
+    for (struct dirent *e; d && (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        if (len > 4 && !strcmp(e->d_name + len - 4, ".ply")) {
+            snprintf(out, n, "%s/%s", dir, e->d_name);
+            found = 0;
+        }
+    }
+    if (d) closedir(d);
+    return found;
+}
+
+/* A cached texture cut short or with a byte changed is named, generated again and sealed,
+ * and the image is the one the whole entry gave (today's build failed on the cut one and
+ * rendered the changed one as it was). */
+static void test_faults_damaged_texture_cache(void)
+{
+    const char *scene = tu_write_file("fault_texture.json", TEXTURE_SCENE);
+    const char *cache = fault_dir("texcache");
+    char cmd[4096], out[4096], ply[1024];
+    static const char *const damage[] = {"truncate -s 1000 '%s'",
+                                         "printf '\\377' | dd of='%s' bs=1 seek=2000 "
+                                         "conv=notrunc 2>/dev/null"};
+    static const char *const why[] = {"bytes where", "its checksum differs"};
+    snprintf(cmd, sizeof cmd, "VBCL_CACHE_DIR=%s %s %s -q -o %s/first.pfm", cache, tu_vbcl, scene,
+             cache);
+    CHECK(tu_run(cmd, out, sizeof out) == 0 && !out[0], "the first render: %s", out);
+    CHECK(cached_texture(cache, ply, sizeof ply) == 0, "the texture is cached in %s", cache);
+    for (int i = 0; i < 2; i++) {
+        snprintf(cmd, sizeof cmd, damage[i], ply);
+        tu_run(cmd, NULL, 0);
+        snprintf(cmd, sizeof cmd, "VBCL_CACHE_DIR=%s %s %s -q -o %s/again.pfm", cache, tu_vbcl,
+                 scene, cache);
+        int rc = tu_run(cmd, out, sizeof out);
+        CHECK(rc == 0 && strstr(out, "cached texture is damaged") && strstr(out, why[i]),
+              "damage %d: named and generated again (%d): %s", i, rc, out);
+        snprintf(cmd, sizeof cmd, "cmp %s/first.pfm %s/again.pfm", cache, cache);
+        CHECK(tu_run(cmd, out, sizeof out) == 0, "damage %d: the same image: %s", i, out);
+        snprintf(cmd, sizeof cmd, "VBCL_CACHE_DIR=%s %s %s -q -o %s/again.pfm", cache, tu_vbcl,
+                 scene, cache);
+        CHECK(tu_run(cmd, out, sizeof out) == 0 && !out[0],
+              "damage %d: the entry made again is whole: %s", i, out);
+    }
+}
+
+/* Messages that name the real cause: no OpenCL platform at all (an empty vendors
+ * directory for the ICD loader), on stderr also for --list-devices; a bad VBCL_DEVICE
+ * named as itself, not as --device. */
+static void test_faults_device_messages(void)
+{
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *empty = fault_dir("vendors");
+    char cmd[4096], out[4096];
+    snprintf(cmd, sizeof cmd, "(OCL_ICD_VENDORS=%s %s --list-devices 2>/dev/null)", empty, tu_vbcl);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && !out[0], "--list-devices with no platform: exit 1, nothing on stdout (%d): %s",
+          rc, out);
+    snprintf(cmd, sizeof cmd, "OCL_ICD_VENDORS=%s %s --list-devices", empty, tu_vbcl);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "no OpenCL platform") && strstr(out, "/etc/OpenCL/vendors"),
+          "--list-devices with no platform says so on stderr (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "OCL_ICD_VENDORS=%s %s %s -q -o %s/none.pfm", empty, tu_vbcl, scene,
+             empty);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "no OpenCL platform"),
+          "a render with no platform: exit 1 naming the cause (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "VBCL_DEVICE=nosuchdevice %s %s -q -o %s/none.pfm", tu_vbcl, scene,
+             empty);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "VBCL_DEVICE=nosuchdevice: no device name contains") &&
+              !strstr(out, "--device"),
+          "a bad VBCL_DEVICE is named as itself (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "VBCL_DEVICE=nosuchdevice %s %s -q --device 0 -o %s/zero.pfm",
+             tu_vbcl, scene, empty);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "--device overrides VBCL_DEVICE (%d): %s", rc, out);
+}
+
+/* The image helper stopped (SIGSTOP) while vbcl renders: vbcl waits
+ * VBCL_IMAGE_HELPER_TIMEOUT seconds for it, says so, kills it and encodes the image itself
+ * (today's build waited forever). A descriptor limit below the helper's socket (ulimit -n
+ * 40) starts no helper, and says nothing about it (today's build printed the helper's
+ * "not an option"). */
+static void test_faults_image_helper(void)
+{
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("helper");
+    char cmd[4096], out[4096], img[1024];
+    snprintf(img, sizeof img, "%s/stopped.png", dir);
+    snprintf(cmd, sizeof cmd,
+             "VBCL_IMAGE_HELPER_TIMEOUT=2 %s %s -q --width 128 --height 128 -o %s & p=$!; "
+             "h=; for i in $(seq 200); do h=$(pgrep -P $p); [ -n \"$h\" ] && break; sleep 0.01; "
+             "done; kill -STOP $h; wait $p; rc=$?; sleep 0.2; "
+             "if kill -0 $h 2>/dev/null; then echo \"helper $h still there\"; kill -9 $h; fi; "
+             "exit $rc",
+             tu_vbcl, scene, img);
+    char timed[4200];
+    snprintf(timed, sizeof timed, "timeout 60 bash -c '%s'", cmd);
+    int rc = tu_run(timed, out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "did not answer in 2 s") && !strstr(out, "still there"),
+          "a stopped helper: ended after 2 s, the image encoded by vbcl (%d): %s", rc, out);
+    int w = 0, h = 0;
+    float *pix = NULL;
+    char err[512];
+    CHECK(image_read(img, &w, &h, &pix, err, sizeof err) == 0 && w == 128 && h == 128,
+          "the image is whole: %s", err);
+    free(pix);
+    snprintf(img, sizeof img, "%s/nofile.png", dir);
+    snprintf(cmd, sizeof cmd, "bash -c 'ulimit -n 40; exec %s %s -q -o %s'", tu_vbcl, scene, img);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && !out[0], "ulimit -n 40: rendered, nothing said (%d): %s", rc, out);
+    CHECK(image_read(img, &w, &h, &pix, err, sizeof err) == 0, "ulimit -n 40: the image: %s", err);
+    free(pix);
+}
+
+/* A ray tree without bound: max_depth 64 with min_weight 0, through two glass slabs (2^64
+ * rays per sample; today's build took it and did not finish 64 x 64 in 120 s), is refused
+ * at once naming both settings; pruned, the same depth renders. */
+static void test_faults_unbounded_tree(void)
+{
+    const char *scene = tu_write_file(
+        "fault_slabs.json",
+        "{\"image\": {\"width\": 16, \"height\": 16},\n"
+        " \"camera\": {\"eye\": [0, 0, 6], \"look_at\": [0, 0, 0]},\n"
+        " \"render\": {\"max_depth\": 64, \"min_weight\": 0},\n"
+        " \"materials\": {\"glass\": {\"k_local\": 0, \"k_global\": 1, \"eta\": 1.5}},\n"
+        " \"objects\": [{\"shape\": \"box\", \"size\": [3, 3, 0.5], \"material\": \"glass\",\n"
+        "               \"transform\": {\"translate\": [0, 0, 1]}},\n"
+        "              {\"shape\": \"box\", \"size\": [3, 3, 0.5], \"material\": \"glass\",\n"
+        "               \"transform\": {\"translate\": [0, 0, -1]}}]}\n");
+    const char *dir = fault_dir("tree");
+    char cmd[4096], out[4096];
+    snprintf(cmd, sizeof cmd, "timeout 60 %s %s -q -o %s/slabs.pfm", tu_vbcl, scene, dir);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "max_depth 64 with min_weight 0") && strstr(out, "2^64"),
+          "depth 64 unpruned: refused (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "timeout 60 %s %s -q --depth 16 --width 2 --height 2 -o %s/slabs.pfm",
+             tu_vbcl, scene, dir);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "depth 16 unpruned is taken (%d): %s", rc, out);
+    snprintf(cmd, sizeof cmd, "timeout 60 %s %s -q --min-weight 0.001 -o %s/slabs.pfm", tu_vbcl,
+             scene, dir);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "depth 64 pruned at 0.001 renders (%d): %s", rc, out);
+}
+
 void suite_faults(void)
 {
     RUN_TEST(test_faults_file_size_limit);
     RUN_TEST(test_faults_full_disk);
     RUN_TEST(test_faults_sync_fails);
     RUN_TEST(test_faults_signal_in_write);
+    RUN_TEST(test_faults_damaged_texture_cache);
+    RUN_TEST(test_faults_device_messages);
+    RUN_TEST(test_faults_image_helper);
+    RUN_TEST(test_faults_unbounded_tree);
 }

@@ -19,7 +19,7 @@ VbDevice *tu_device(void)
 {
     if (device_state == 0) {
         char err[512];
-        if (clu_device_open(getenv("VBCL_DEVICE"), &device, err, sizeof err)) {
+        if (clu_device_open(NULL, &device, err, sizeof err)) {
             fprintf(stderr, "    no OpenCL device: %s\n", err);
             device_state = -1;
         } else {

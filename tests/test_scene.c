@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cache.h"
 #include "harness.h"
 #include "scene.h"
 #include "testutil.h"
@@ -196,6 +197,12 @@ static void test_scene_out_of_range(void)
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"radius\": -1}]}",
                  "objects[0].radius: -1 is out of range: expected > 0", NULL);
+    /* past a float's range: not "expected >= 0" */
+    expect_error("{\"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+                 " \"materials\": {\"m\": {\"extinction\": 1e300}}}",
+                 "materials.m.extinction: 1e+300 is out of range: expected at most 3.40282e+38 "
+                 "(the largest float)",
+                 NULL);
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\", "
                                 "\"level\": 40}]}",
                  "objects[0].level", "out of range");
@@ -346,12 +353,25 @@ static void test_scene_texture_generate_inline(void)
     snprintf(cmd, sizeof cmd, "ls %s/textures", cache);
     tu_run(cmd, listing, sizeof listing);
     CHECK(strstr(listing, ".ply") != NULL, "generated into the cache: %s", listing);
-    /* the second load reads the cached file: make it unreadable as a mesh to prove it */
-    snprintf(cmd, sizeof cmd, "for f in %s/textures/*.ply; do echo broken > $f; done", cache);
-    tu_run(cmd, NULL, 0);
+    /* the second load reads the cached file: make it unreadable as a mesh, and seal it as
+     * whole (cache_seal), to prove it */
+    snprintf(cmd, sizeof cmd, "for f in %s/textures/*.ply; do echo broken > $f; echo $f; done",
+             cache);
+    char ply[1024] = "";
+    tu_run(cmd, ply, sizeof ply);
+    ply[strcspn(ply, "\n")] = 0;
+    char serr[512] = "";
+    CHECK(cache_seal(ply, serr, sizeof serr) == 0, "sealed %s: %s", ply, serr);
     rc = load_text(json, &s, err, sizeof err);
     CHECK(rc == 2 && strstr(err, "objects[0].texture.generate"),
           "the cached file is what loads: %s", err);
+    if (rc == 0) scene_free(&s);
+    /* broken and not sealed as such: generated again (test_faults.c damages it the other
+     * ways) */
+    snprintf(cmd, sizeof cmd, "echo broken again > %s", ply);
+    tu_run(cmd, NULL, 0);
+    rc = load_text(json, &s, err, sizeof err);
+    CHECK(rc == 0, "a damaged entry is generated again: %s", err);
     if (rc == 0) scene_free(&s);
     if (old[0])
         setenv("VBCL_CACHE_DIR", old, 1);
@@ -383,6 +403,9 @@ static void test_scene_texture_generate_inline(void)
     expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
                                 "   \"texture\": {\"generate\": \"bombs\", \"material\": \"m\"}}]}",
                  "objects[0].texture.generate", "expected \"bomb ...\" or \"deform ...\"");
+    expect_error(MIN_SCENE_HEAD " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\","
+                                "   \"texture\": {\"generate\": \"bombs\", \"material\": \"m\"}}]}",
+                 "objects[0].texture.generate", "\"bombs\": expected"); /* the value it got */
 }
 
 /* Every shape's triangle count is known from its parameters, and the scene is refused

@@ -125,22 +125,48 @@ double clu_event_ms(cl_event ev)
     return b > a ? (double)(b - a) * 1e-6 : 0.0;
 }
 
-/* All devices of all platforms, in listing order. Returns the count (<= max). */
+/* Why enumerate found no device: no platform, or platforms whose drivers gave none. */
+static char enumerate_why[512];
+
+/* All devices of all platforms, in listing order. Returns the count (<= max); with none,
+ * enumerate_why says why. */
 static int enumerate(cl_platform_id *plats, cl_device_id *devs, int max)
 {
     cl_uint np = 0;
     cl_platform_id pl[16];
-    if (clGetPlatformIDs(16, pl, &np) != CL_SUCCESS) return 0;
+    cl_int rc = clGetPlatformIDs(16, pl, &np);
+    if (rc != CL_SUCCESS || np == 0) {
+        snprintf(enumerate_why, sizeof enumerate_why,
+                 "no OpenCL platform: the ICD loader found no driver (%s; the drivers are "
+                 "listed in /etc/OpenCL/vendors/*.icd): install one (make deps installs PoCL)",
+                 rc == CL_SUCCESS ? "0 platforms" : clu_error_name(rc));
+        return 0;
+    }
     int n = 0;
+    size_t len = (size_t)snprintf(enumerate_why, sizeof enumerate_why,
+                                  "no OpenCL device: the drivers gave none (");
     for (cl_uint i = 0; i < np && i < 16; i++) {
         cl_uint nd = 0;
         cl_device_id dv[32];
-        if (clGetDeviceIDs(pl[i], CL_DEVICE_TYPE_ALL, 32, dv, &nd) != CL_SUCCESS) continue;
+        rc = clGetDeviceIDs(pl[i], CL_DEVICE_TYPE_ALL, 32, dv, &nd);
+        if (rc != CL_SUCCESS || nd == 0) {
+            char name[128] = "";
+            clGetPlatformInfo(pl[i], CL_PLATFORM_NAME, sizeof name, name, NULL);
+            if (len < sizeof enumerate_why)
+                len += (size_t)snprintf(enumerate_why + len, sizeof enumerate_why - len, "%s%s: %s",
+                                        i ? "; " : "", name,
+                                        rc == CL_SUCCESS ? "0 devices" : clu_error_name(rc));
+            continue;
+        }
         for (cl_uint k = 0; k < nd && k < 32 && n < max; k++) {
             plats[n] = pl[i];
             devs[n++] = dv[k];
         }
     }
+    if (len < sizeof enumerate_why)
+        snprintf(enumerate_why + len, sizeof enumerate_why - len,
+                 "); PoCL needs a writable cache directory (HOME, XDG_CACHE_HOME or "
+                 "POCL_CACHE_DIR); check with clinfo");
     return n;
 }
 
@@ -157,8 +183,7 @@ int clu_list_devices(FILE *out)
     cl_platform_id plats[64];
     cl_device_id devs[64];
     int n = enumerate(plats, devs, 64);
-    if (n == 0)
-        fprintf(out, "no OpenCL devices found (is an ICD such as pocl-opencl-icd installed?)\n");
+    if (n == 0) fprintf(stderr, "vbcl: %s\n", enumerate_why);
     for (int i = 0; i < n; i++) {
         char name[256], ver[128] = "", cver[128] = "";
         cl_device_type type = 0;
@@ -212,7 +237,7 @@ static int device_matches(cl_platform_id plat, cl_device_id dev, const char *ite
  * whose own name or version does; so "pocl,intel" names PoCL and Intel's runtime even on an
  * Intel CPU, whose name PoCL's device carries. Returns the index, or -1 after a message
  * in err. */
-static int device_pick(const char *spec, const char *item, cl_platform_id *plats,
+static int device_pick(const char *label, const char *spec, const char *item, cl_platform_id *plats,
                        cl_device_id *devs, int n, const int *picks, int count, char *err,
                        size_t errlen)
 {
@@ -220,7 +245,7 @@ static int device_pick(const char *spec, const char *item, cl_platform_id *plats
     long idx = strtol(item, &end, 10);
     if (*end == 0 && end != item) {
         if (idx >= 0 && idx < n) return (int)idx;
-        snprintf(err, errlen, "--device %s: no such device %s (there are %d; see --list-devices)",
+        snprintf(err, errlen, "%s%s: no such device %s (there are %d; see --list-devices)", label,
                  spec, item, n);
         return -1;
     }
@@ -234,9 +259,9 @@ static int device_pick(const char *spec, const char *item, cl_platform_id *plats
             named = i;
         }
     if (named >= 0)
-        snprintf(err, errlen, "--device %s: device %d is named twice", spec, named);
+        snprintf(err, errlen, "%s%s: device %d is named twice", label, spec, named);
     else
-        snprintf(err, errlen, "--device %s: no device name contains \"%s\" (see --list-devices)",
+        snprintf(err, errlen, "%s%s: no device name contains \"%s\" (see --list-devices)", label,
                  spec, item);
     return -1;
 }
@@ -247,10 +272,14 @@ int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t err
     cl_device_id devs[64];
     int n = enumerate(plats, devs, 64), count = 0;
     if (n == 0) {
-        snprintf(err, errlen,
-                 "no OpenCL device found: install an OpenCL driver (make deps "
-                 "installs PoCL) and check with clinfo");
+        snprintf(err, errlen, "%s", enumerate_why);
         return -1;
+    }
+    /* the list given, named as the user gave it: the option, else the variable */
+    const char *label = "--device ";
+    if (!spec) {
+        spec = getenv("VBCL_DEVICE");
+        label = "VBCL_DEVICE=";
     }
     if (!spec || !*spec) spec = "0";
     if (!strcmp(spec, "all")) {
@@ -261,21 +290,21 @@ int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t err
     for (const char *p = spec;; p++) {
         size_t len = strcspn(p, ",");
         if (len == 0 || len >= sizeof item) {
-            snprintf(err, errlen,
-                     "--device %s: expected all, or indices and names separated by commas", spec);
+            snprintf(err, errlen, "%s%s: expected all, or indices and names separated by commas",
+                     label, spec);
             return -2;
         }
         memcpy(item, p, len);
         item[len] = 0;
-        int pick = device_pick(spec, item, plats, devs, n, picks, count, err, errlen);
+        int pick = device_pick(label, spec, item, plats, devs, n, picks, count, err, errlen);
         if (pick < 0) return -2;
         for (int k = 0; k < count; k++)
             if (picks[k] == pick) {
-                snprintf(err, errlen, "--device %s: device %d is named twice", spec, pick);
+                snprintf(err, errlen, "%s%s: device %d is named twice", label, spec, pick);
                 return -2;
             }
         if (count == max) {
-            snprintf(err, errlen, "--device %s: at most %d devices", spec, max);
+            snprintf(err, errlen, "%s%s: at most %d devices", label, spec, max);
             return -2;
         }
         picks[count++] = pick;

@@ -80,7 +80,8 @@ int clu_list_devices(FILE *out);
 /* The devices spec names, as indices of clu_list_devices: "all", or a comma-separated list
  * of items, each an index or a case-insensitive part of a name (among the devices the list
  * has not named yet, the first whose platform's name contains it, else whose device name
- * or version does); NULL or "" is device 0. Returns how many (<= max) are in
+ * or version does); NULL is $VBCL_DEVICE (named so in messages), and NULL or "" there is
+ * device 0. Returns how many (<= max) are in
  * picks, -1 when there is no OpenCL device at all, or -2 when spec is not a valid list
  * (a usage error: an item that matches nothing, a device named twice); err says which. */
 int clu_device_pick(const char *spec, int *picks, int max, char *err, size_t errlen);

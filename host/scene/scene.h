@@ -73,6 +73,10 @@ static inline int scene_penumbra_feelers_ok(int k)
     return k >= 1 && k <= SCENE_PENUMBRA_FEELERS_MAX && (k & (k - 1)) == 0;
 }
 
+/* The deepest ray tree vbcl traces without pruning (min_weight 0): 2^16 rays per sample
+ * at most. */
+#define SCENE_UNPRUNED_MAX_DEPTH 16
+
 typedef struct Scene {
     char *path; /* the scene file as given */
     char *dir;  /* its directory, for relative mesh paths */
@@ -85,8 +89,8 @@ typedef struct Scene {
     vec3 eye, look_at, up;
     float fov; /* vertical, degrees */
     /* render */
-    int max_depth;
-    int grid_res[3];    /* all 0: auto */
+    int max_depth;   /* with min_weight 0 at most SCENE_UNPRUNED_MAX_DEPTH (main.c refuses more) */
+    int grid_res[3]; /* all 0: auto */
     float grid_density; /* cells per triangle of `auto`; 0: the default (grid_build_levels) */
     int subgrid_res[3]; /* the second level's resolution in every crowded cell; all 0: auto */
     float subgrid_density;

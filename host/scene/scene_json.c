@@ -109,6 +109,9 @@ static const char *range_text(double lo, double hi, char *buf, size_t n)
 /* The error for a number v outside [lo, hi] at path p. */
 int scene_fail_range(Ctx *c, const char *p, double v, double lo, double hi)
 {
+    if ((hi == FLT_MAX || hi == DBL_MAX) && v > hi) /* "unbounded", but a float's limit */
+        return scene_fail(c, p, "%s is out of range: expected at most %s (the largest %s)",
+                          diag_num(v), diag_num(hi), hi == FLT_MAX ? "float" : "double");
     char r[96];
     range_text(lo, hi, r, sizeof r);
     return scene_fail(c, p, "%s is out of range%s%s", diag_num(v),

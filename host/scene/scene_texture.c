@@ -160,18 +160,26 @@ static int generate_texture(Ctx *c, const char *q, const char *args, Mesh *tex, 
     if (!(w1 == 4 && !strncmp(args + w0, "bomb", 4)) &&
         !(w1 == 6 && !strncmp(args + w0, "deform", 6)))
         return scene_fail(c, q,
-                          "expected \"bomb ...\" or \"deform ...\" (the texgen methods that make "
-                          "volume textures)");
+                          "\"%s\": expected \"bomb ...\" or \"deform ...\" (the texgen methods "
+                          "that make volume textures)",
+                          diag_value(args));
     if (split_args(c, q, args, buf, sizeof buf, argv, &argc)) return -1;
     uint64_t h = cache_hash(cache_hash(CACHE_HASH_SEED, "vbcl texgen 1: "), args);
     int cached = cache_dir("textures", dir, sizeof dir) != NULL;
     if (cached) snprintf(path, sizeof path, "%s/%016llx.ply", dir, (unsigned long long)h);
-    if (cached && access(path, R_OK) == 0) /* generated before */
-        return load_texture_file(c, q, path, tex, declared, has_declared);
+    if (cached && access(path, R_OK) == 0) { /* generated before: used if whole */
+        char why[128];
+        if (cache_check_seal(path, why, sizeof why) == 0)
+            return load_texture_file(c, q, path, tex, declared, has_declared);
+        diag_print("vbcl", "%s: the cached texture is damaged (%s): generating it again", path,
+                   why);
+        cache_remove(path);
+    }
     TexSet t;
     if (run_texgen(c, q, argc, argv, &t)) return -1;
     int rc = texset_to_mesh(c, q, &t, tex, declared, has_declared);
-    if (!rc && cached) texset_write(&t, path, err, sizeof err);
+    if (!rc && cached && texset_write(&t, path, err, sizeof err) == 0)
+        cache_seal(path, err, sizeof err);
     texset_free(&t);
     return rc;
 }

@@ -1,6 +1,8 @@
 /* cache.c — the cache directory and the hash that keys its files. */
 #include "cache.h"
 
+#include "fileio.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <pthread.h>
@@ -152,4 +154,74 @@ int cache_prune(const char *dir, const char *suffix, uint64_t max_bytes, const c
     }
     free(files);
     return removed;
+}
+
+/* The FNV-1a hash (cache_hash's, over bytes) and the size of the file at path; 0, or -1
+ * when it cannot be read. */
+static int file_hash(const char *path, uint64_t *h, uint64_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    unsigned char buf[1 << 16];
+    *h = CACHE_HASH_SEED;
+    *size = 0;
+    for (size_t k; (k = fread(buf, 1, sizeof buf, f)) > 0; *size += k)
+        for (size_t i = 0; i < k; i++) *h = (*h ^ buf[i]) * 1099511628211ull;
+    int bad = ferror(f);
+    fclose(f);
+    return bad ? -1 : 0;
+}
+
+/* The seal's path: path + ".sum". */
+static int seal_path(const char *path, char *out, size_t n)
+{
+    int k = snprintf(out, n, "%s.sum", path);
+    return k < 0 || (size_t)k >= n ? -1 : 0;
+}
+
+int cache_seal(const char *path, char *err, size_t errlen)
+{
+    char sum[4200], text[64];
+    uint64_t h, size;
+    if (seal_path(path, sum, sizeof sum) || file_hash(path, &h, &size)) {
+        snprintf(err, errlen, "%s: cannot read it back to seal it", path);
+        return -1;
+    }
+    int k = snprintf(text, sizeof text, "fnv1a64 %016llx %llu\n", (unsigned long long)h,
+                     (unsigned long long)size);
+    return file_write_whole(sum, text, (size_t)k, err, errlen);
+}
+
+int cache_check_seal(const char *path, char *why, size_t n)
+{
+    char sum[4200];
+    unsigned long long want_h, want_size;
+    uint64_t h, size;
+    FILE *f = seal_path(path, sum, sizeof sum) ? NULL : fopen(sum, "r");
+    int got = f ? fscanf(f, "fnv1a64 %16llx %llu", &want_h, &want_size) : 0;
+    if (f) fclose(f);
+    if (got != 2) {
+        snprintf(why, n, "no checksum beside it");
+        return -1;
+    }
+    if (file_hash(path, &h, &size)) {
+        snprintf(why, n, "it cannot be read");
+        return -1;
+    }
+    if (size != want_size) {
+        snprintf(why, n, "%llu bytes where %llu were written", (unsigned long long)size, want_size);
+        return -1;
+    }
+    if (h != want_h) {
+        snprintf(why, n, "its checksum differs");
+        return -1;
+    }
+    return 0;
+}
+
+void cache_remove(const char *path)
+{
+    char sum[4200];
+    remove(path);
+    if (!seal_path(path, sum, sizeof sum)) remove(sum);
 }

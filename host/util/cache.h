@@ -34,4 +34,16 @@ int cache_prune(const char *dir, const char *suffix, uint64_t max_bytes, const c
 #define CACHE_HASH_SEED 1469598103934665603ull
 uint64_t cache_hash(uint64_t h, const char *s);
 
+/* Seals the cache entry at path: path + ".sum" gets the FNV-1a hash and the size of its
+ * bytes (written whole, fileio.h). Returns 0, or -1 with a message in err. */
+int cache_seal(const char *path, char *err, size_t errlen);
+
+/* Whether the entry at path is whole: 0 when its bytes match its seal, else -1 with the
+ * reason in why ("no checksum beside it", "12 bytes where 4096 were written", "its
+ * checksum differs"). */
+int cache_check_seal(const char *path, char *why, size_t n);
+
+/* Removes the entry at path and its seal. */
+void cache_remove(const char *path);
+
 #endif

@@ -19,8 +19,11 @@
  * call. */
 #include "image_io.h"
 
+#include "diag.h"
+
 #include <dlfcn.h>
 #include <errno.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
@@ -29,6 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -150,7 +154,8 @@ static struct {
     pid_t pid;
     int fd;
     int tried; /* helper_start was called: one helper a run */
-} helper = {0, -1, 0};
+    int stuck; /* it did not answer within helper_timeout_ms */
+} helper = {0, -1, 0, 0};
 
 /* An encoding request: the header, then path_len bytes of path (whose extension names the
  * format), then width * height * 4 floats. The reply: rc (0 or -1), then err_len bytes of
@@ -167,13 +172,21 @@ typedef struct {
     uint64_t bytes;
 } HelperReply;
 
-/* Sends or receives all n bytes; 0, or -1 on an error or the other end gone. */
-static int sock_all(int fd, void *buf, size_t n, int sending)
+/* Sends or receives all n bytes, waiting at most timeout_ms (-1: forever) for each part to
+ * move; 0, -1 on an error or the other end gone, or -3 when the wait ran out. */
+static int sock_all_within(int fd, void *buf, size_t n, int sending, int timeout_ms)
 {
     char *p = buf;
     while (n > 0) {
-        ssize_t k = sending ? send(fd, p, n, MSG_NOSIGNAL) : recv(fd, p, n, 0);
-        if (k < 0 && errno == EINTR) continue;
+        struct pollfd pf = {fd, (short)(sending ? POLLOUT : POLLIN), 0};
+        int ready = timeout_ms < 0 ? 1 : poll(&pf, 1, timeout_ms);
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready == 0) return -3;
+        if (ready < 0) return -1;
+        /* with a bound, never block in the call: it moves what fits and poll waits again */
+        int flags = timeout_ms < 0 ? 0 : MSG_DONTWAIT;
+        ssize_t k = sending ? send(fd, p, n, MSG_NOSIGNAL | flags) : recv(fd, p, n, flags);
+        if (k < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
         if (k <= 0) return -1;
         p += k;
         n -= (size_t)k;
@@ -181,13 +194,30 @@ static int sock_all(int fd, void *buf, size_t n, int sending)
     return 0;
 }
 
-/* Ends the helper: closing the socket tells it to exit; then it is reaped. */
+static int sock_all(int fd, void *buf, size_t n, int sending)
+{
+    return sock_all_within(fd, buf, n, sending, -1);
+}
+
+/* How long vbcl waits for the helper to take or give the next bytes before it ends it and
+ * encodes the image itself: $VBCL_IMAGE_HELPER_TIMEOUT seconds, default 120. */
+static int helper_timeout_ms(void)
+{
+    const char *env = getenv("VBCL_IMAGE_HELPER_TIMEOUT");
+    char *end;
+    long s = env ? strtol(env, &end, 10) : 0;
+    return env && *env && !*end && s > 0 && s < 86400 ? (int)s * 1000 : 120000;
+}
+
+/* Ends the helper: closing the socket tells it to exit; then it is reaped. One that did not
+ * answer in time (stopped, or stuck) is killed first, so that nothing waits for it. */
 static void helper_stop(void)
 {
     pthread_mutex_lock(&helper_lock);
     if (helper.fd >= 0) {
         close(helper.fd);
         helper.fd = -1;
+        if (helper.stuck) kill(helper.pid, SIGKILL);
         while (waitpid(helper.pid, NULL, 0) < 0 && errno == EINTR) {
         }
     }
@@ -200,6 +230,8 @@ static int helper_start(void)
 {
     const char *env = getenv("VBCL_IMAGE_HELPER");
     if (env && !strcmp(env, "0")) return -1;
+    struct rlimit nofile; /* the helper's socket is descriptor HELPER_FD: it must be allowed */
+    if (getrlimit(RLIMIT_NOFILE, &nofile) == 0 && nofile.rlim_cur <= HELPER_FD) return -1;
     int sv[2];
     if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv)) return -1;
     posix_spawn_file_actions_t fa;
@@ -236,14 +268,15 @@ static int helper_encode(const char *path, int width, int height, const float *r
                          unsigned char **out, size_t *nout, char *err, size_t errlen)
 {
     pthread_mutex_lock(&helper_lock);
-    int rc = -2;
+    int rc = -2, t = helper_timeout_ms(), s = -1;
     size_t plen = strlen(path), bytes = sizeof(float) * 4 * (size_t)width * (size_t)height;
     HelperRequest q = {HELPER_MAGIC, width, height, exposure, (uint32_t)plen};
     HelperReply a;
-    if (helper.fd >= 0 && !sock_all(helper.fd, &q, sizeof q, 1) &&
-        !sock_all(helper.fd, (void *)path, plen, 1) &&
-        !sock_all(helper.fd, (void *)rgba, bytes, 1) && !sock_all(helper.fd, &a, sizeof a, 0) &&
-        a.err_len < 4096 && a.bytes <= SIZE_MAX) {
+    if (helper.fd >= 0 && !(s = sock_all_within(helper.fd, &q, sizeof q, 1, t)) &&
+        !(s = sock_all_within(helper.fd, (void *)path, plen, 1, t)) &&
+        !(s = sock_all_within(helper.fd, (void *)rgba, bytes, 1, t)) &&
+        !(s = sock_all_within(helper.fd, &a, sizeof a, 0, t)) && a.err_len < 4096 &&
+        a.bytes <= SIZE_MAX) {
         char msg[4096];
         unsigned char *data = a.bytes ? malloc((size_t)a.bytes) : NULL;
         if (a.bytes && !data) {
@@ -251,8 +284,8 @@ static int helper_encode(const char *path, int width, int height, const float *r
                      (unsigned long long)a.bytes);
             rc = -1;
             helper.fd = (close(helper.fd), -1); /* its reply cannot be read: end it */
-        } else if (!sock_all(helper.fd, msg, a.err_len, 0) &&
-                   !sock_all(helper.fd, data, (size_t)a.bytes, 0)) {
+        } else if (!(s = sock_all_within(helper.fd, msg, a.err_len, 0, t)) &&
+                   !(s = sock_all_within(helper.fd, data, (size_t)a.bytes, 0, t))) {
             msg[a.err_len] = 0;
             if (a.rc) snprintf(err, errlen, "%s", msg);
             rc = a.rc ? -1 : 0;
@@ -262,8 +295,15 @@ static int helper_encode(const char *path, int width, int height, const float *r
         }
         free(data);
     }
+    if (s == -3) {
+        helper.stuck = 1;
+        diag_print("vbcl",
+                   "the image helper (pid %ld) did not answer in %d s: it is ended, and vbcl "
+                   "encodes %s itself",
+                   (long)helper.pid, t / 1000, path);
+    }
     pthread_mutex_unlock(&helper_lock);
-    if (rc == -2) helper_stop(); /* gone: not asked again */
+    if (rc == -2) helper_stop(); /* gone or stuck: not asked again */
     return rc;
 }
 

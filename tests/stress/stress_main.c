@@ -137,7 +137,7 @@ int main(int argc, char **argv)
     }
     VbDevice d;
     char err[512];
-    if (clu_device_open(getenv("VBCL_DEVICE"), &d, err, sizeof err)) {
+    if (clu_device_open(NULL, &d, err, sizeof err)) {
         fprintf(stderr, "vbcl-stress: no OpenCL device: %s\n", err);
         return 1;
     }
