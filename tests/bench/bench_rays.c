@@ -830,8 +830,7 @@ static int bench_open(Bench *b)
         return 2;
     }
     b->npix = (size_t)b->s.width * (size_t)b->s.height;
-    int rc =
-        clu_device_open(o->device, &b->dev, err, sizeof err);
+    int rc = clu_device_open(o->device, &b->dev, err, sizeof err);
     if (!rc) {
         rc = renderer_init(&b->r, &b->dev, &b->s, vbcl_probe_source, &b->st, err, sizeof err);
         if (rc) clu_device_close(&b->dev);
