@@ -35,13 +35,14 @@ static const char usage_text[] =
     "usage: vbcl SCENE.json [options]\n"
     "       vbcl --list-devices\n"
     "       vbcl --warm-cache [--device ...]\n"
+    "       vbcl texgen METHOD [options] -o FILE   (3D textures: vbcl texgen --help)\n"
     "\n"
     "Renders a volume-textured scene with OpenCL and writes the image; the format follows\n"
     "the extension: .png .jpg .tif (8-bit sRGB), .exr or .pfm (linear float; vbcl writes\n"
     ".pfm itself, without OpenImageIO). SCENE.json may be a pipe; - reads it from standard\n"
     "input (mesh paths then start at the current directory).\n"
     "\n"
-    "options (each overrides the scene's own setting):\n"
+    "options (each overrides the scene's own setting; --option=value works too):\n"
     "  -o, --output FILE        image to write (default: image.output, else SCENE.png);\n"
     "                           frames of an animation are numbered: a run of # in FILE\n"
     "                           becomes the frame number, else FILE_0007.png\n"
@@ -310,10 +311,32 @@ static int option_special(Options *o, const char *a, const char *val)
     return -2;
 }
 
+/* The options option_special reads. */
+static const char *const special_options[] = {"--frames", "--fresnel",        "--exposure",
+                                              "--bands",  "--aa-reconstruct", "--aa-pairs"};
+
 static int is_special_option(const char *a)
 {
-    return !strcmp(a, "--frames") || !strcmp(a, "--fresnel") || !strcmp(a, "--exposure") ||
-           !strcmp(a, "--bands") || !strcmp(a, "--aa-reconstruct") || !strcmp(a, "--aa-pairs");
+    for (size_t k = 0; k < sizeof special_options / sizeof special_options[0]; k++)
+        if (!strcmp(a, special_options[k])) return 1;
+    return 0;
+}
+
+/* "unknown option A", with the nearest option's name when one is near (diag_suggest). */
+static int unknown_option(const char *a)
+{
+    enum { NSPEC = sizeof option_specs / sizeof option_specs[0] };
+    enum { NSPECIAL = sizeof special_options / sizeof special_options[0] };
+    const char *names[NSPEC + NSPECIAL + 3];
+    size_t n = 0;
+    for (size_t k = 0; k < NSPEC; k++) names[n++] = option_specs[k].name;
+    for (size_t k = 0; k < NSPECIAL; k++) names[n++] = special_options[k];
+    names[n++] = "--help";
+    names[n++] = "--version";
+    names[n] = NULL;
+    const char *near = diag_suggest(a, names);
+    if (near) return usage_error("unknown option %s: did you mean %s?", diag_value(a), near);
+    return usage_error("unknown option %s", diag_value(a));
 }
 
 /* Reads the command line into o. Returns -1 to go on and render, or an exit status (0
@@ -326,9 +349,23 @@ static int parse_args(int argc, char **argv, Options *o)
     o->aa_level_gain = -1;
     o->aa_max_level = o->aa_min_level = o->ssaa = o->bands = o->seed = -1;
     o->frame_first = o->frame_last = -1;
+    static char named[64]; /* the option of an --option=value, without its value */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
+        const char *eq = !strncmp(a, "--", 2) ? strchr(a, '=') : NULL;
+        if (eq && (size_t)(eq - a) < sizeof named) { /* --option=value */
+            snprintf(named, sizeof named, "%.*s", (int)(eq - a), a);
+            const OptionSpec *fs = option_find(named);
+            if (fs && fs->kind == OPT_FLAG)
+                return usage_error("%s takes no value (got %s)", named, diag_value(a));
+            if (fs || is_special_option(named)) {
+                int rc = fs ? option_store(o, fs, named, eq + 1) : option_special(o, named, eq + 1);
+                if (rc >= 0) return rc;
+                continue;
+            }
+            return unknown_option(named);
+        }
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage_text, stdout);
             return 0;
@@ -346,7 +383,7 @@ static int parse_args(int argc, char **argv, Options *o)
             int rc = spec ? option_store(o, spec, a, val) : option_special(o, a, val);
             if (rc >= 0) return rc;
         } else if (a[0] == '-' && a[1]) {
-            return usage_error("unknown option %s", diag_value(a));
+            return unknown_option(a);
         } else if (o->scene) {
             return usage_error("one scene at a time (also got %s)", diag_value(a));
         } else {

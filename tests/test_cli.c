@@ -1212,9 +1212,72 @@ static void test_cli_stats_json(void)
     CHECK(!dir_has(tu_tmpdir(), ".statsdir.tmp"), "no temporary file left beside it");
 }
 
+/* What a user of another renderer types: the nearest valid key or option is suggested
+ * (edit distance, and names other renderers use: ior, center, color), --option=value is
+ * taken, and --help names vbcl texgen. */
+static void test_cli_suggestions(void)
+{
+    static const struct {
+        const char *key, *where, *near;
+    } keys[] = {
+        {"\"ior\": 1.5", "materials", "did you mean \"eta\"?"},
+        {"\"color\": [1, 0, 0]", "materials", "did you mean \"diffuse\"?"},
+        {"\"difuse\": [1, 0, 0]", "materials", "did you mean \"diffuse\"?"},
+        {"\"center\": [2, 4, 3]", "lights", "did you mean \"centre\"?"},
+        {"\"coluor\": [1, 1, 1]", "lights", "did you mean \"colour\"?"},
+        {"\"zoom\": 2", "camera", NULL},
+    };
+    char text[2048];
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        const char *m =
+            !strcmp(keys[i].where, "materials") ? keys[i].key : "\"diffuse\": [1, 1, 1]";
+        const char *l = !strcmp(keys[i].where, "lights") ? keys[i].key : "\"centre\": [2, 4, 3]";
+        const char *c = !strcmp(keys[i].where, "camera") ? keys[i].key : "\"fov\": 40";
+        snprintf(text, sizeof text,
+                 "{\"camera\": {\"eye\": [0, 1, 5], \"look_at\": [0, 0, 0], %s},\n"
+                 " \"lights\": [{%s, \"flux\": 500}],\n"
+                 " \"materials\": {\"m\": {%s}},\n"
+                 " \"objects\": [{\"shape\": \"sphere\", \"material\": \"m\"}]}\n",
+                 c, l, m);
+        expect_bad(text, "", keys[i].near ? keys[i].near : "unknown key (expected one of");
+    }
+    char out[16384], args[1024];
+    const char *scene = tu_write_file("suggest.json", GOOD_SCENE);
+    snprintf(args, sizeof args, "%s --widht 8", scene);
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "unknown option --widht: did you mean --width?"),
+          "--widht: suggested (%d): %s", rc, out);
+    snprintf(args, sizeof args, "%s --sead 3", scene);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "did you mean --seed?"), "--sead (%d): %s", rc, out);
+    snprintf(args, sizeof args, "%s --zzzzzz 3", scene);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && !strstr(out, "did you mean"), "nothing near --zzzzzz (%d): %s", rc, out);
+    char a[512], b[512];
+    snprintf(a, sizeof a, "%s/eq_a.pfm", tu_tmpdir());
+    snprintf(b, sizeof b, "%s/eq_b.pfm", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -q --width=12 --height=10 --seed=3 --output=%s", scene, a);
+    CHECK(vbcl(args, out, sizeof out) == 0, "--option=value: %s", out);
+    snprintf(args, sizeof args, "%s -q --width 12 --height 10 --seed 3 -o %s", scene, b);
+    CHECK(vbcl(args, out, sizeof out) == 0, "--option value: %s", out);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "cmp %s %s", a, b);
+    CHECK(tu_run(cmd, out, sizeof out) == 0, "--option=value is --option value: %s", out);
+    snprintf(args, sizeof args, "%s --stats=yes", scene);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--stats takes no value"), "a flag with a value (%d): %s", rc,
+          out);
+    snprintf(args, sizeof args, "%s --width=", scene);
+    rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 2, "--width= with no value: exit 2 (%d): %s", rc, out);
+    rc = vbcl("--help", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "vbcl texgen"), "--help names vbcl texgen");
+}
+
 void suite_cli(void)
 {
     RUN_TEST(test_cli_help_and_usage);
+    RUN_TEST(test_cli_suggestions);
     RUN_TEST(test_cli_image_plugin);
     RUN_TEST(test_cli_cache_pruned);
     RUN_TEST(test_cli_cache_binaries);

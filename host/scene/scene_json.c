@@ -82,6 +82,10 @@ int json_check_keys(Ctx *c, const cJSON *obj, const char *path, const char *cons
                 if (a != allowed) strncat(list, ", ", sizeof list - strlen(list) - 1);
                 strncat(list, *a, sizeof list - strlen(list) - 1);
             }
+            const char *near = diag_suggest(k->string, allowed);
+            if (near)
+                return scene_fail(c, p, "unknown key: did you mean \"%s\"? (expected one of: %s)",
+                                  near, list);
             return scene_fail(c, p, "unknown key (expected one of: %s)", list);
         }
         for (const cJSON *o = obj->child; o != k; o = o->next)

@@ -26,4 +26,11 @@ const char *diag_value(const char *s);
  * other numbers as %g. Rotating static buffers, like diag_value. */
 const char *diag_num(double v);
 
+/* The choice nearest to word, for "did you mean ...?": a name other renderers use for it
+ * (`ior` for eta, `center` and `position` for centre, `color` for diffuse: the choice must be
+ * among choices), else the closest by edit distance (insertions, deletions, substitutions
+ * and swaps of neighbours, case ignored) when it is at most a third of the word's length
+ * (1 for short words). choices ends with NULL. Returns NULL when none is near. */
+const char *diag_suggest(const char *word, const char *const *choices);
+
 #endif
