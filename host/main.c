@@ -528,12 +528,6 @@ static int apply_options(const Options *o, Scene *s)
                            o->aa_map ? "--aa-map" : "--aa-samples-map");
     if (o->fresnel)
         s->fresnel = strcmp(o->fresnel, "thesis") == 0 ? SCENE_FRESNEL_THESIS : SCENE_FRESNEL_EXACT;
-    if (s->min_weight == 0.0f && s->max_depth > SCENE_UNPRUNED_MAX_DEPTH)
-        return usage_error("max_depth %d with min_weight 0 (render.max_depth and "
-                           "render.min_weight, or --depth and --min-weight): a ray tree that is "
-                           "never pruned can hold 2^%d rays per sample; give min_weight > 0 (the "
-                           "default is 0.001) or max_depth <= %d",
-                           s->max_depth, s->max_depth, SCENE_UNPRUNED_MAX_DEPTH);
     if (o->grid && scene_parse_grid_levels(o->grid, s->grid_res, s->subgrid_res))
         return usage_error("--grid %s: expected TOP or TOP:SUB, each auto, N or NX,NY,NZ (TOP "
                            "1..1024 each, at most 2^27 = 134217728 cells in all; SUB 1..64 each)",

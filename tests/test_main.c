@@ -111,5 +111,6 @@ int main(int argc, char **argv)
     suite_structure();
     suite_scale();
     suite_faults();
+    suite_frame();
     return th_summary();
 }

@@ -39,5 +39,6 @@ void suite_dispersion(void);
 void suite_structure(void);
 void suite_scale(void);
 void suite_faults(void);
+void suite_frame(void);
 
 #endif

@@ -158,6 +158,52 @@ static int load_camera(Ctx *c, const cJSON *j, Scene *s)
     if (v3_len(fwd) <= 0.0f) return scene_fail(c, "camera.look_at", "must differ from camera.eye");
     if (v3_len(v3_cross(fwd, s->up)) <= 1e-6f * v3_len(fwd) * v3_len(s->up))
         return scene_fail(c, "camera.up", "must not be parallel to the viewing direction");
+    double eye[3], look[3];
+    json_numbers(cJSON_GetObjectItemCaseSensitive(j, "eye"), s->eye, eye);
+    json_numbers(cJSON_GetObjectItemCaseSensitive(j, "look_at"), s->look_at, look);
+    scene_frame_pick(s, eye, look);
+    return 0;
+}
+
+void scene_frame_pick(Scene *s, const double eye[3], const double look_at[3])
+{
+    double d = 0.0, far = 0.0;
+    for (int k = 0; k < 3; k++) {
+        d += (look_at[k] - eye[k]) * (look_at[k] - eye[k]);
+        far += look_at[k] * look_at[k];
+    }
+    d = sqrt(d);
+    far = sqrt(far);
+    s->frame_scale = 1.0f;
+    if (d < SCENE_FRAME_MIN_VIEW || d > SCENE_FRAME_MAX_VIEW)
+        s->frame_scale = (float)exp2(-round(log2(d)));
+    for (int k = 0; k < 3; k++)
+        s->frame_origin[k] = far > SCENE_FRAME_FAR_VIEWS * d ? look_at[k] : 0;
+    s->eye = scene_frame_point(s, eye);
+    s->look_at = scene_frame_point(s, look_at);
+}
+
+vec3 scene_frame_point(const Scene *s, const double p[3])
+{
+    double k = s->frame_scale;
+    return v3((float)((p[0] - s->frame_origin[0]) * k), (float)((p[1] - s->frame_origin[1]) * k),
+              (float)((p[2] - s->frame_origin[2]) * k));
+}
+
+int scene_frame_is_identity(const Scene *s)
+{
+    return s->frame_scale == 1.0f && s->frame_origin[0] == 0.0 && s->frame_origin[1] == 0.0 &&
+           s->frame_origin[2] == 0.0;
+}
+
+int scene_get_point(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
+                    const Scene *s, vec3 *out)
+{
+    vec3 v;
+    if (json_get_vec3(c, obj, path, key, def, &v)) return -1;
+    double d[3];
+    json_numbers(cJSON_GetObjectItemCaseSensitive(obj, key), v, d);
+    *out = scene_frame_point(s, d);
     return 0;
 }
 
@@ -372,7 +418,7 @@ static int load_lights(Ctx *c, const cJSON *j, Scene *s)
         vec3 centre;
         float radius, colour[3];
         double flux, intensity;
-        if (json_get_vec3(c, e, p, "centre", NULL, &centre) ||
+        if (scene_get_point(c, e, p, "centre", NULL, s, &centre) ||
             json_get_float(c, e, p, "radius", 0, FLT_MAX, 0, 0, &radius) ||
             json_get_num(c, e, p, "flux", DBL_MIN, FLT_MAX, -1, 0, &flux) ||
             json_get_num(c, e, p, "intensity", DBL_MIN, FLT_MAX, -1, 0, &intensity) ||
@@ -384,10 +430,10 @@ static int load_lights(Ctx *c, const cJSON *j, Scene *s)
         double I = intensity > 0 ? intensity : flux / (4.0 * M_PI);
         double scale = radius > 0 ? I / (M_PI * (double)radius * radius) : I;
         VbLight *l = &s->lights[i];
-        l->centre[0] = centre.x;
+        l->centre[0] = centre.x; /* in the frame; the radiance stays, as (r / d)^2 does */
         l->centre[1] = centre.y;
         l->centre[2] = centre.z;
-        l->radius = radius;
+        l->radius = radius * s->frame_scale;
         for (int k = 0; k < 3; k++) l->radiance[k] = (float)(scale * colour[k]);
         if (!isfinite(l->radiance[0] + l->radiance[1] + l->radiance[2]))
             return scene_fail(c, p, "radiance overflows: the light is too bright for its size");

@@ -73,10 +73,6 @@ static inline int scene_penumbra_feelers_ok(int k)
     return k >= 1 && k <= SCENE_PENUMBRA_FEELERS_MAX && (k & (k - 1)) == 0;
 }
 
-/* The deepest ray tree vbcl traces without pruning (min_weight 0): 2^16 rays per sample
- * at most. */
-#define SCENE_UNPRUNED_MAX_DEPTH 16
-
 typedef struct Scene {
     char *path; /* the scene file as given */
     char *dir;  /* its directory, for relative mesh paths */
@@ -88,9 +84,17 @@ typedef struct Scene {
     /* camera */
     vec3 eye, look_at, up;
     float fov; /* vertical, degrees */
+    /* The frame everything is stored and rendered in (scene_frame_pick): a point p of the
+     * scene file is (p - frame_origin) * frame_scale here, lengths scale by frame_scale
+     * (a power of two, so exactly) and extinctions by its inverse. The identity for a view
+     * of ordinary size near the origin; a scene far smaller or larger than a unit, or far
+     * from the origin, is brought to one, so that every float and every epsilon of the
+     * renderer sees it as it sees a unit scene (docs/architecture.md, "Scale"). */
+    double frame_origin[3];
+    float frame_scale;
     /* render */
-    int max_depth;   /* with min_weight 0 at most SCENE_UNPRUNED_MAX_DEPTH (main.c refuses more) */
-    int grid_res[3]; /* all 0: auto */
+    int max_depth;
+    int grid_res[3];    /* all 0: auto */
     float grid_density; /* cells per triangle of `auto`; 0: the default (grid_build_levels) */
     int subgrid_res[3]; /* the second level's resolution in every crowded cell; all 0: auto */
     float subgrid_density;
@@ -168,6 +172,22 @@ int scene_load_text(const char *path, const char *text, int frame, Scene *s, cha
 
 /* The name messages give the scene file at path: "<stdin>" for "-". */
 const char *scene_display_name(const char *path);
+
+/* Picks s->frame_origin and frame_scale from the camera as written (eye and look_at, in
+ * double): the scale 2^-round(log2 d) of the viewing distance d when d <
+ * SCENE_FRAME_MIN_VIEW or d > SCENE_FRAME_MAX_VIEW, else 1; the origin look_at when it lies
+ * more than SCENE_FRAME_FAR_VIEWS viewing distances from (0, 0, 0), else (0, 0, 0). Then
+ * puts the camera in that frame. */
+#define SCENE_FRAME_MIN_VIEW  (1.0 / 16.0)
+#define SCENE_FRAME_MAX_VIEW  1024.0
+#define SCENE_FRAME_FAR_VIEWS 64.0
+void scene_frame_pick(Scene *s, const double eye[3], const double look_at[3]);
+
+/* Point p of the scene file (in double, as written) in s's frame. */
+vec3 scene_frame_point(const Scene *s, const double p[3]);
+
+/* Whether s's frame is the scene file's own (origin 0, scale 1). */
+int scene_frame_is_identity(const Scene *s);
 
 /* Frees everything scene_load allocated. */
 void scene_free(Scene *s);

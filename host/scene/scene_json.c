@@ -206,6 +206,17 @@ int json_get_vec(Ctx *c, const cJSON *obj, const char *path, const char *key, in
     return json_read_vec(c, j, p, n, lo, hi, out);
 }
 
+void json_numbers(const cJSON *arr, vec3 parsed, double out[3])
+{
+    out[0] = parsed.x;
+    out[1] = parsed.y;
+    out[2] = parsed.z;
+    if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) != 3) return;
+    int k = 0;
+    for (const cJSON *e = arr->child; e && k < 3; e = e->next, k++)
+        if (cJSON_IsNumber(e)) out[k] = e->valuedouble;
+}
+
 int json_get_vec3(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
                   vec3 *out)
 {

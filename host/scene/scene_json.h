@@ -52,6 +52,9 @@ int json_get_int(Ctx *c, const cJSON *obj, const char *path, const char *key, in
 int json_read_vec(Ctx *c, const cJSON *j, const char *p, int n, double lo, double hi, float *out);
 int json_get_vec(Ctx *c, const cJSON *obj, const char *path, const char *key, int n, double lo,
                  double hi, const float *def, float *out);
+/* The three numbers of arr as written (double), where arr is an array of three numbers;
+ * else parsed's (json_numbers is for values already checked). */
+void json_numbers(const cJSON *arr, vec3 parsed, double out[3]);
 int json_get_vec3(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
                   vec3 *out);
 int json_get_rgb(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,

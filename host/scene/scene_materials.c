@@ -37,6 +37,14 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
         json_get_vec(c, j, p, "origin", 3, -FLT_MAX, FLT_MAX, zero, pt->origin) ||
         json_get_scalar_or_vec3(c, j, p, "size", FLT_MIN, FLT_MAX, 1, pt->size))
         return -1;
+    double od[3];
+    json_numbers(cJSON_GetObjectItemCaseSensitive(j, "origin"),
+                 v3(pt->origin[0], pt->origin[1], pt->origin[2]), od);
+    vec3 origin = scene_frame_point(s, od);
+    pt->origin[0] = origin.x; /* patterns lie in the scene's frame too */
+    pt->origin[1] = origin.y;
+    pt->origin[2] = origin.z;
+    for (int k = 0; k < 3; k++) pt->size[k] *= s->frame_scale;
     pt->seed = (unsigned long long)seed;
     const cJSON *img = cJSON_GetObjectItemCaseSensitive(j, "image");
     json_path_key(q, p, "image");
@@ -202,6 +210,7 @@ int scene_load_materials(Ctx *c, const cJSON *j, Scene *s)
         if (json_get_scalar_or_vec3(c, e, p, "extinction", 0, FLT_MAX, 0, g->extinction) ||
             load_pattern(c, e, p, s, &m->pattern) || load_dispersion(c, e, p, g->eta, &m->disp))
             return -1;
+        for (int k = 0; k < 3; k++) g->extinction[k] /= s->frame_scale; /* per frame length */
         if (m->pattern.kind) g->pattern = 0;           /* has one; the renderer assigns the index */
         g->disp = m->disp.model != DISP_NONE ? 0 : -1; /* likewise its band table's offset */
     }

@@ -66,7 +66,8 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     mesh_init(&tex);
     mat4 xf;
     int rc = -1;
-    if (scene_load_shape(c, o, p, shape->valuestring, s, &m) || scene_load_transform(c, o, p, &xf))
+    if (scene_load_shape(c, o, p, shape->valuestring, s, &m) ||
+        scene_load_transform_framed(c, o, p, s, &xf))
         goto done;
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "texture");
     if (t) {

@@ -19,6 +19,14 @@ void scene_default_band_layout(const cJSON *render, Scene *s);
 /* obj.transform as an object-to-world matrix: scale, rotate about x, y, z, translate
  * (identity when absent) (scene_shapes.c). */
 int scene_load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf);
+/* The same into s's frame (scene_frame_pick): the translation subtracted from the frame's
+ * origin in double, as written, so that an object far from (0, 0, 0) keeps its digits. */
+int scene_load_transform_framed(Ctx *c, const cJSON *obj, const char *path, const Scene *s,
+                                mat4 *xf);
+/* The point obj[key] (checked as json_get_vec3 does; def when absent) in s's frame, from the
+ * numbers as written (double). */
+int scene_get_point(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,
+                    const Scene *s, vec3 *out);
 /* Tessellates one object's shape into m (object space). */
 int scene_load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, const Scene *s,
                      Mesh *m);

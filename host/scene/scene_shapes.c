@@ -44,6 +44,24 @@ int scene_load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     return 0;
 }
 
+int scene_load_transform_framed(Ctx *c, const cJSON *obj, const char *path, const Scene *s,
+                                mat4 *xf)
+{
+    if (scene_load_transform(c, obj, path, xf)) return -1;
+    if (scene_frame_is_identity(s)) return 0;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(obj, "transform");
+    vec3 parsed = v3(xf->m[0][3], xf->m[1][3], xf->m[2][3]);
+    double tr[3];
+    json_numbers(t ? cJSON_GetObjectItemCaseSensitive(t, "translate") : NULL, parsed, tr);
+    vec3 moved = scene_frame_point(s, tr); /* scale * (translate - origin), in double */
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) xf->m[i][j] *= s->frame_scale; /* a power of two: exact */
+    xf->m[0][3] = moved.x;
+    xf->m[1][3] = moved.y;
+    xf->m[2][3] = moved.z;
+    return 0;
+}
+
 /* objects[i] with "shape": "revolution": a profile swept about the y axis (its triangle
  * count was checked before any shape was built: scene_count_triangles). */
 static int load_revolution(Ctx *c, const cJSON *o, const char *p, Mesh *m)
