@@ -34,6 +34,12 @@ VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMater
     float3 q = (p - vb_gload3(pt->origin)) * vb_gload3(pt->inv_size);
     if (pt->kind == VBCL_PATTERN_FOURIER)
         return (float3)(fmax(0.0f, solidtex_fourier_eval(&pt->fourier, q.x, q.y, q.z)));
+    if (pt->kind == VBCL_PATTERN_CHECKER) { /* the parity of the cell along the axes used */
+        int3 cell = convert_int3_sat(floor(q));
+        int sum = ((pt->axes & 1u) ? cell.x : 0) + ((pt->axes & 2u) ? cell.y : 0) +
+                  ((pt->axes & 4u) ? cell.z : 0);
+        return vb_gload3(pt->colours[sum & 1]);
+    }
     int t = solidtex_projection_texel(pt->width, pt->height, q.x, q.y);
     if (t < 0) return (float3)(0.0f);
     return vload3(0, sc->texels + 4 * ((size_t)pt->texel_offset + (size_t)t));

@@ -23,6 +23,7 @@
 /* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
 #define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
 #define VBCL_PATTERN_PROJECTION 2 /* orthogonal projection of an image along Z */
+#define VBCL_PATTERN_CHECKER    3 /* cells of two colours, constant along the axes not in axes */
 
 /* Volume textures: at most this many objects per scene carry one; the medium state keeps
  * an 8-bit count of elements per textured object. */
@@ -146,7 +147,10 @@ typedef struct VbPattern {
     unsigned int texel_offset; /* projection: first texel (4 floats each) in the texels */
     float origin[4];
     float inv_size[4];
-    VbFourier fourier; /* VBCL_PATTERN_FOURIER */
+    VbFourier fourier;   /* VBCL_PATTERN_FOURIER */
+    float colours[2][4]; /* VBCL_PATTERN_CHECKER: the cell of (0, 0, 0) and its neighbours' */
+    unsigned int axes;   /* VBCL_PATTERN_CHECKER: bit k set: the cells alternate along axis k */
+    unsigned int pad[3];
 } VbPattern;
 
 /* An object as the kernels see it: its material, for a host its volume texture, and
@@ -384,7 +388,7 @@ typedef struct VbSplitSet {
     X(sizeof(VbHit)) X(sizeof(VbTriangle)) X(sizeof(VbTriNormals)) X(sizeof(VbMaterial))          \
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
-    X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(sizeof(VbObject))                 \
+    X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(VBCL_OFFSETOF(VbPattern, colours)) X(VBCL_OFFSETOF(VbPattern, axes)) X(sizeof(VbObject)) \
     X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) X(VBCL_OFFSETOF(VbObject, ahead)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
@@ -410,8 +414,10 @@ VBCL_STATIC_ASSERT(sizeof(VbTriangle) == 48, triangle_size);
 VBCL_STATIC_ASSERT(sizeof(VbTriNormals) == 48, trinormals_size);
 VBCL_STATIC_ASSERT(sizeof(VbMaterial) == 96, material_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, pattern) == 80, material_pattern);
-VBCL_STATIC_ASSERT(sizeof(VbPattern) == 48 + 240, pattern_size);
+VBCL_STATIC_ASSERT(sizeof(VbPattern) == 48 + 240 + 48, pattern_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbPattern, fourier) == 48, pattern_fourier);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbPattern, colours) == 48 + 240, pattern_colours);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbPattern, axes) == 48 + 240 + 32, pattern_axes);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, exponent) == 64, material_exponent);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, eta) == 76, material_eta);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbMaterial, disp) == 84, material_disp);

@@ -1,6 +1,7 @@
 /* test_patterns.c — surface-colour solid textures in the kernel (thesis 2.2.2.3): Gardner's
- * Fourier synthesis equals the host's evaluation, and an orthogonal projection returns the
- * image's own texels, through a probe and through a whole render. */
+ * Fourier synthesis equals the host's evaluation, an orthogonal projection returns the
+ * image's own texels, through a probe and through a whole render, and a checker gives each
+ * cell its colour by the parity of its indices. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,7 +40,11 @@ static const char *write_image(void)
     "   \"g\": {\"pattern\": {\"type\": \"fourier\", \"terms\": 6, \"contrast\": 0.5,"             \
     "          \"frequency\": [2, 3, 4], \"seed\": 7, \"origin\": [1, 2, 3], \"size\": 2}},"       \
     "   \"img\": {\"diffuse\": [1, 1, 1], \"pattern\": {\"type\": \"projection\", \"image\": "     \
-    "\"%s\"}}},"                                                                                   \
+    "\"%s\"}},"                                                                                    \
+    "   \"chk\": {\"pattern\": {\"type\": \"checker\", \"size\": 0.5, \"origin\": [0.1, 0, 0.2],"  \
+    "          \"colours\": [[1, 0, 0], [0, 0, 1]]}},"                                             \
+    "   \"chk3\": {\"pattern\": {\"type\": \"checker\", \"size\": [0.5, 0.25, 2], \"axes\": "      \
+    "\"xyz\"}}},"                                                                                  \
     " \"objects\": [{\"shape\": \"quad\", \"size\": [2, 1], \"material\": \"img\","                \
     "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0.5, 0.5, 0]}}]}"
 
@@ -155,8 +160,59 @@ static void test_patterns_render_projection(void)
     free(px);
 }
 
+/* A checker in the kernel: at random points (negative coordinates among them), colour 0
+ * where the cells' indices floor((p - origin) / size) along its axes sum to an even number,
+ * colour 1 where odd; constant along the other axes ("xz", a floor's default), or cubes
+ * ("xyz"); the default colours are 0.9 and 0.15 grey. */
+static void test_patterns_checker(void)
+{
+    char json[4096];
+    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
+    Fixture fx;
+    if (fixture_open(&fx, json)) return;
+    enum { N = 256 };
+    float pts[N * 4], out[N * 4];
+    unsigned seed = 11;
+    for (int i = 0; i < N; i++) {
+        for (int k = 0; k < 3; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            pts[4 * i + k] = (float)(seed >> 8) / 16777216.0f * 8.0f - 4.0f;
+        }
+        pts[4 * i + 3] = 0;
+    }
+    cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
+    const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    int n = N;
+    for (int mat = 3; mat <= 4; mat++) { /* "chk" (xz), "chk3" (xyz) */
+        const void *v[] = {&mat, &mp, &n, &mo};
+        fixture_run_probe(&fx, "probe_pattern", N, 4, sz, v);
+        read_buffer(mo, out, sizeof out);
+        int bad = 0, odd = 0;
+        for (int i = 0; i < N; i++) {
+            const float *p = pts + 4 * i;
+            long cells =
+                mat == 3
+                    ? (long)floor((p[0] - 0.1) / 0.5) + (long)floor((p[2] - 0.2) / 0.5)
+                    : (long)floor(p[0] / 0.5) + (long)floor(p[1] / 0.25) + (long)floor(p[2] / 2);
+            int par = (int)(cells & 1);
+            odd += par;
+            const float want[2][2][3] = {{{1, 0, 0}, {0, 0, 1}},
+                                         {{0.9f, 0.9f, 0.9f}, {0.15f, 0.15f, 0.15f}}};
+            const float *w = want[mat - 3][par];
+            if (out[4 * i] != w[0] || out[4 * i + 1] != w[1] || out[4 * i + 2] != w[2]) bad++;
+        }
+        CHECK(bad == 0, "material %d: %d of %d points have the other cell's colour", mat, bad, N);
+        CHECK(odd > N / 4 && odd < 3 * N / 4, "material %d: both colours appear (%d odd)", mat,
+              odd);
+    }
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mo);
+    fixture_close(&fx);
+}
+
 void suite_patterns(void)
 {
     RUN_TEST(test_patterns_probe_matches_host);
     RUN_TEST(test_patterns_render_projection);
+    RUN_TEST(test_patterns_checker);
 }

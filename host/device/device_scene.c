@@ -206,6 +206,12 @@ static int pattern_make(const Scene *s, int i, VbPattern *pt, Texels *tx, char *
         pt->origin[k] = sp->origin[k];
         pt->inv_size[k] = 1.0f / sp->size[k];
     }
+    if (sp->kind == VBCL_PATTERN_CHECKER) {
+        for (int c = 0; c < 2; c++)
+            for (int k = 0; k < 3; k++) pt->colours[c][k] = sp->colours[c][k];
+        pt->axes = sp->axes;
+        return 0;
+    }
     if (sp->kind == VBCL_PATTERN_FOURIER) {
         if (!texgen_fourier_init(&pt->fourier, sp->terms, sp->contrast, sp->freq, sp->seed, perr,
                                  sizeof perr))

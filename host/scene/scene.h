@@ -19,7 +19,9 @@
 /* A material's surface pattern as the scene gives it; the renderer turns it into a
  * VbPattern (Fourier coefficients, image texels). */
 typedef struct ScenePattern {
-    int kind; /* 0 none, VBCL_PATTERN_FOURIER or VBCL_PATTERN_PROJECTION */
+    int kind;            /* 0 none, VBCL_PATTERN_FOURIER, _PROJECTION or _CHECKER */
+    float colours[2][3]; /* checker: the two colours */
+    unsigned axes;       /* checker: bit k, the cells alternate along axis k */
     int terms;
     float contrast, freq[3];
     unsigned long long seed;

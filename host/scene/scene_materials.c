@@ -11,10 +11,53 @@
 #include "diag.h"
 
 /* materials.NAME.pattern: a Fourier or projection surface pattern (thesis 2.2.2.3). */
+/* A checker's "colours" (two colours; light and dark grey by default) and "axes" (the axes
+ * along which its cells alternate: "xz" by default, a floor's), refused on other patterns. */
+static int load_checker(Ctx *c, const cJSON *j, const char *p, ScenePattern *pt)
+{
+    static const float grey[2][3] = {{0.9f, 0.9f, 0.9f}, {0.15f, 0.15f, 0.15f}};
+    const cJSON *col = cJSON_GetObjectItemCaseSensitive(j, "colours");
+    const cJSON *ax = cJSON_GetObjectItemCaseSensitive(j, "axes");
+    char q[PATH_MAX_LEN], r[PATH_MAX_LEN];
+    if (pt->kind != VBCL_PATTERN_CHECKER) {
+        if (!col && !ax) return 0;
+        json_path_key(q, p, col ? "colours" : "axes");
+        return scene_fail(c, q, "only a checker pattern takes colours and axes");
+    }
+    memcpy(pt->colours, grey, sizeof grey);
+    json_path_key(q, p, "colours");
+    if (col && (!cJSON_IsArray(col) || cJSON_GetArraySize(col) != 2))
+        return scene_fail(c, q, "expected two colours, [[r, g, b], [r, g, b]]");
+    for (int k = 0; col && k < 2; k++) {
+        json_path_index(r, q, k);
+        if (json_read_vec(c, cJSON_GetArrayItem(col, k), r, 3, 0.0, FLT_MAX, pt->colours[k]))
+            return -1;
+    }
+    pt->axes = 1u | 4u;
+    json_path_key(q, p, "axes");
+    if (ax) {
+        const char *a = cJSON_IsString(ax) ? ax->valuestring : NULL;
+        pt->axes = 0;
+        for (const char *ch = a; ch && *ch; ch++) {
+            unsigned bit = *ch == 'x' ? 1u : *ch == 'y' ? 2u : *ch == 'z' ? 4u : 8u;
+            if (bit == 8u || (pt->axes & bit)) {
+                pt->axes = 0;
+                break;
+            }
+            pt->axes |= bit;
+        }
+        if (!pt->axes)
+            return scene_fail(c, q,
+                              "expected the axes the cells alternate along: \"x\", \"xz\", "
+                              "\"xyz\" ... (each once)");
+    }
+    return 0;
+}
+
 static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s, ScenePattern *pt)
 {
-    static const char *const keys[] = {"type",  "terms",  "contrast", "frequency", "seed",
-                                       "image", "origin", "size",     NULL};
+    static const char *const keys[] = {"type",   "terms", "contrast", "frequency", "seed", "image",
+                                       "origin", "size",  "colours",  "axes",      NULL};
     static const float zero[3] = {0, 0, 0};
     const cJSON *j = cJSON_GetObjectItemCaseSensitive(e, "pattern");
     if (!j) return 0;
@@ -27,8 +70,11 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
         pt->kind = VBCL_PATTERN_FOURIER;
     else if (t && cJSON_IsString(t) && strcmp(t->valuestring, "projection") == 0)
         pt->kind = VBCL_PATTERN_PROJECTION;
+    else if (t && cJSON_IsString(t) && strcmp(t->valuestring, "checker") == 0)
+        pt->kind = VBCL_PATTERN_CHECKER;
     else
-        return scene_fail(c, q, "expected \"fourier\" or \"projection\"");
+        return scene_fail(c, q, "expected \"fourier\", \"projection\" or \"checker\"");
+    if (load_checker(c, j, p, pt)) return -1;
     double seed;
     if (json_get_int(c, j, p, "terms", 4, 7, 5, 0, &pt->terms) ||
         json_get_float(c, j, p, "contrast", 0, 100, 1, 0, &pt->contrast) ||
