@@ -442,8 +442,9 @@ static void test_scene_triangles_counted_first(void)
     free(text);
 }
 
-/* Dielectric and textured objects must not overlap (issue 17): surfaces that meet or touch,
- * or one inside the other, name both objects; apart, or overlapping an opaque object, load. */
+/* Dielectric and textured objects must not overlap (issue 17): surfaces that cross or touch,
+ * or one nested inside the other, each named as what it is, both objects named; apart, or
+ * overlapping an opaque object, load. */
 static void test_scene_hosts_disjoint(void)
 {
 #define GLASS_SCENE(objs)                                                                          \
@@ -454,11 +455,17 @@ static void test_scene_hosts_disjoint(void)
         GLASS_SCENE("{\"shape\": \"box\", \"material\": \"m\"},"
                     " {\"name\": \"left\", \"shape\": \"sphere\", \"material\": \"g\"},"
                     " {\"shape\": \"sphere\", \"material\": \"g\", \"centre\": [1.5, 0, 0]}"),
-        "objects: left and objects[2] overlap", "must not overlap");
+        "objects: left and objects[2] overlap or touch: their surfaces meet", "must be apart");
     expect_error(GLASS_SCENE("{\"name\": \"outer\", \"shape\": \"sphere\", \"material\": \"g\","
                              "  \"radius\": 2},"
                              " {\"name\": \"inner\", \"shape\": \"box\", \"material\": \"g\"}"),
-                 "objects: inner is inside outer", NULL);
+                 "objects: inner lies wholly inside outer (nested)", NULL);
+    /* a box sticking out of a ball: its surfaces cross the ball's, whatever vertex is
+     * inside (it was called "inside" before) */
+    expect_error(GLASS_SCENE("{\"name\": \"ball\", \"shape\": \"sphere\", \"material\": \"g\"},"
+                             " {\"name\": \"box\", \"shape\": \"box\", \"material\": \"g\","
+                             "  \"transform\": {\"translate\": [0.9, 0, 0]}}"),
+                 "overlap or touch: their surfaces meet", "ball");
     expect_error(GLASS_SCENE("{\"name\": \"a\", \"shape\": \"box\", \"material\": \"g\"},"
                              " {\"name\": \"b\", \"shape\": \"box\", \"material\": \"g\","
                              "  \"transform\": {\"translate\": [1, 0, 0]}}"),

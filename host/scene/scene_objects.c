@@ -191,9 +191,10 @@ static void object_bounds(const Scene *s, const SceneObject *o, vec3 *lo, vec3 *
 }
 
 /* Hosts (dielectric or textured objects) must not overlap: the medium the kernels track is
- * one host at a time. Refused: surfaces that meet or touch (mesh_parts_meet, the exact test
- * texgen uses for its elements) and one host inside another. Only hosts whose bounding box
- * overlaps another host's are tested. */
+ * one host at a time. Refused, each in its own words: surfaces that cross or touch
+ * (mesh_parts_meet, the exact test texgen uses for its elements), and, where no surfaces
+ * meet, one host nested inside another. Only hosts whose bounding box overlaps another
+ * host's are tested. */
 static int check_hosts_disjoint(Ctx *c, const Scene *s)
 {
     int nh = 0, np = 0, *idx = malloc(sizeof(int) * 2 * (size_t)s->nobjects);
@@ -206,20 +207,19 @@ static int check_hosts_disjoint(Ctx *c, const Scene *s)
             object_bounds(s, &s->objects[i], &box[2 * nh], &box[2 * nh + 1]);
             idx[nh++] = i;
         }
+    int nest_in = -1, nest_out = -1; /* a host with a vertex inside another */
     for (int i = 0; !rc && i < nh; i++) {
         int near = 0;
-        for (int j = 0; !rc && j < nh; j++) {
+        for (int j = 0; j < nh; j++) {
             vec3 l0 = box[2 * i], h0 = box[2 * i + 1], l1 = box[2 * j], h1 = box[2 * j + 1];
             if (j == i || l0.x > h1.x || l1.x > h0.x || l0.y > h1.y || l1.y > h0.y || l0.z > h1.z ||
                 l1.z > h0.z)
                 continue;
             near = 1;
-            const SceneObject *oi = &s->objects[idx[i]], *oj = &s->objects[idx[j]];
-            if (vertex_inside(s, oi, oj))
-                rc = scene_fail(c, "objects",
-                                "%s is inside %s: dielectric and textured objects must not overlap "
-                                "(docs/scene-format.md)",
-                                diag_value(oi->name), diag_value(oj->name));
+            if (nest_in < 0 && vertex_inside(s, &s->objects[idx[i]], &s->objects[idx[j]])) {
+                nest_in = idx[i];
+                nest_out = idx[j];
+            }
         }
         if (near) {
             const SceneObject *o = &s->objects[idx[i]];
@@ -233,11 +233,18 @@ static int check_hosts_disjoint(Ctx *c, const Scene *s)
     if (meet < 0) rc = scene_fail(c, NULL, "out of memory");
     if (meet > 0)
         rc = scene_fail(c, "objects",
-                        "%s and %s overlap (triangle %u of one meets triangle %u of the other): "
-                        "dielectric and textured objects must not overlap or touch "
-                        "(docs/scene-format.md)",
+                        "%s and %s overlap or touch: their surfaces meet (triangle %u of one "
+                        "meets triangle %u of the other); dielectric and textured objects must "
+                        "be apart (docs/scene-format.md)",
                         diag_value(s->objects[pobj[pa]].name),
                         diag_value(s->objects[pobj[pb]].name), ta, tb);
+    else if (!rc && nest_in >= 0)
+        rc =
+            scene_fail(c, "objects",
+                       "%s lies wholly inside %s (nested); dielectric and textured objects must "
+                       "be apart: put a volume inside another as a texture "
+                       "(docs/scene-format.md)",
+                       diag_value(s->objects[nest_in].name), diag_value(s->objects[nest_out].name));
     free(idx);
     free(parts);
     free(box);
