@@ -539,6 +539,20 @@ static int apply_options(const Options *o, Scene *s)
  * *json and the document written (again after each frame of an animation, so the file
  * always holds the frames done); the summary line on stdout unless -q. Returns an exit
  * status. */
+/* How many devices did the work: entries of ranks on one machine that name the same device
+ * index count once (two ranks may drive one device). */
+static int distinct_devices(const DeviceWork *w, int n)
+{
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        int seen = 0;
+        for (int j = 0; j < i && !seen; j++)
+            seen = w[j].index == w[i].index && !strcmp(w[j].host, w[i].host);
+        count += !seen;
+    }
+    return count;
+}
+
 static int report_frame(const Options *o, const StatsFrame *fr, const char *out, cJSON **json)
 {
     const Scene *s = fr->scene;
@@ -558,10 +572,13 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
         unsigned long long rays = stats_rays_total(fr->st);
         double render_ms = fr->st->render_ms;
         char on[300];
-        if (fr->nwork > 1)
-            snprintf(on, sizeof on, "%d devices (--stats: each one's share)", fr->nwork);
+        int ndevices = distinct_devices(fr->work, fr->nwork);
+        if (ndevices > 1)
+            snprintf(on, sizeof on, "%d devices (--stats: each one's share)", ndevices);
         else
             snprintf(on, sizeof on, "%s", fr->dev->name);
+        if (fr->nwork > ndevices) /* ranks that share a device */
+            snprintf(on + strlen(on), sizeof on - strlen(on), ", %d queues", fr->nwork);
         if (mpi_rank >= 0) snprintf(on + strlen(on), sizeof on - strlen(on), ", rank %d", mpi_rank);
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
                out, s->width, s->height, fr->total_ms / 1000.0, s->mesh.ntris, rays,

@@ -380,6 +380,7 @@ static void json_times(cJSON *root, const StatsFrame *fr, int *ok)
         num(d, "index", w->index, ok);
         num(d, "rank", w->rank, ok);
         str(d, "name", w->name, ok);
+        str(d, "host", w->host, ok);
         num(d, "tiles", (double)w->tiles, ok);
         num(d, "rays", (double)w->rays, ok);
         num(d, "busy_ms", w->busy_ms, ok);

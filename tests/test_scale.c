@@ -294,7 +294,20 @@ static void test_scale_mpi_identical(void)
     cJSON_ArrayForEach(dv, devs) ranks += json_num(dv, "rank");
     CHECK(cJSON_GetArraySize(devs) == 2 && ranks == 1, "frame 0's devices: %d, ranks sum %.0f",
           cJSON_GetArraySize(devs), ranks);
+    const char *h0 = cJSON_GetStringValue(
+                   cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(devs, 0), "host")),
+               *h1 = cJSON_GetStringValue(
+                   cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(devs, 1), "host"));
+    CHECK(h0 && h1 && h0[0] && !strcmp(h0, h1), "both ranks name this host (%s, %s)",
+          h0 ? h0 : "none", h1 ? h1 : "none");
     cJSON_Delete(doc);
+    /* two ranks on one machine and one device: one device in the summary, two queues */
+    snprintf(cmd, sizeof cmd,
+             "%s%s scenes/quickstart.json --width 32 --height 32 -o %s/mpi_one.pfm", env, tu_vbcl,
+             tu_tmpdir());
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && !strstr(out, "on 2 devices") && strstr(out, ", 2 queues"),
+          "the summary counts one device (%d): %s", rc, out);
 }
 
 /* A device that fails on rank 1 (VBCL_FAIL_TILE, an MPMD launch) and a rank that is killed:

@@ -29,6 +29,8 @@ typedef struct DeviceWork {
     char name[256];           /* "platform / device" */
     int index;                /* its index in --list-devices */
     int rank;                 /* the MPI rank that drove it (0 without MPI) */
+    char host[64];            /* the machine it is on (gethostname): ranks on one machine
+                               * that name the same device index share that device */
     unsigned long long tiles; /* pass-0 tiles traced */
     unsigned long long rays;  /* every ray it traced, refinement included */
     double busy_ms;           /* wall time spent tracing (pass 0 and refinement) */

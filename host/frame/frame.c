@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
                size_t errlen)
@@ -14,6 +15,7 @@ int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats 
     for (int i = 0; i < ndev && i < CLU_MAX_DEVICES; i++) {
         snprintf(fr->work[i].name, sizeof fr->work[i].name, "%s", devs[i].name);
         fr->work[i].index = devs[i].index;
+        if (gethostname(fr->work[i].host, sizeof fr->work[i].host - 1)) fr->work[i].host[0] = 0;
     }
     int rc = renderer_init(&fr->r, &devs[0], s, NULL, st, err, errlen);
     if (rc || ndev < 2) return rc;
