@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -126,6 +127,7 @@ double clu_event_ms(cl_event ev)
 }
 
 /* Why enumerate found no device: no platform, or platforms whose drivers gave none. */
+#define CLU_MIN_FILES 16 /* descriptors below which a missing platform is blamed on the limit */
 static char enumerate_why[512];
 
 /* All devices of all platforms, in listing order. Returns the count (<= max); with none,
@@ -135,6 +137,15 @@ static int enumerate(cl_platform_id *plats, cl_device_id *devs, int max)
     cl_uint np = 0;
     cl_platform_id pl[16];
     cl_int rc = clGetPlatformIDs(16, pl, &np);
+    struct rlimit nofile; /* the ICD loader opens a file per driver, the driver its own */
+    if ((rc != CL_SUCCESS || np == 0) && getrlimit(RLIMIT_NOFILE, &nofile) == 0 &&
+        nofile.rlim_cur < CLU_MIN_FILES) {
+        snprintf(enumerate_why, sizeof enumerate_why,
+                 "no OpenCL platform: the driver could not be loaded with so few file "
+                 "descriptors (the descriptor limit, ulimit -n, is %lld; vbcl needs %d or more)",
+                 (long long)nofile.rlim_cur, CLU_MIN_FILES);
+        return 0;
+    }
     if (rc != CL_SUCCESS || np == 0) {
         snprintf(enumerate_why, sizeof enumerate_why,
                  "no OpenCL platform: the ICD loader found no driver (%s; the drivers are "
