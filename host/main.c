@@ -568,6 +568,12 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
             return 1;
         }
     }
+    if (!o->quiet && fr->st->tree_cut)
+        fprintf(stderr,
+                "vbcl: warning: %llu ray-tree branches were not traced: their samples' trees "
+                "reached %d rays (render.max_depth %d, render.min_weight %g); raise min_weight or "
+                "lower max_depth for an image without the cut (docs/stats.md, ray_tree.tree_cut)\n",
+                fr->st->tree_cut, VBCL_TREE_MAX_RAYS, s->max_depth, (double)s->min_weight);
     if (!o->quiet) {
         unsigned long long rays = stats_rays_total(fr->st);
         double render_ms = fr->st->render_ms;

@@ -72,9 +72,10 @@ static void print_tree(FILE *f, const Scene *s, const RenderStats *st)
 {
     fprintf(f,
             "ray tree    reflected %llu, transmitted %llu, total internal reflections %llu; not "
-            "traced: %llu pruned (weight < %g), %llu deeper than max depth %d\n",
+            "traced: %llu pruned (weight < %g), %llu deeper than max depth %d, %llu left when "
+            "a tree reached %d rays\n",
             st->reflected, st->transmitted, st->tir, st->pruned, (double)s->min_weight,
-            st->depth_cut, s->max_depth);
+            st->depth_cut, s->max_depth, st->tree_cut, VBCL_TREE_MAX_RAYS);
     fprintf(f, "energy      %llu interfaces split, %llu with |R + T - 1| > 1e-5\n", st->interfaces,
             st->energy_errors);
     if (st->features & VBCL_FEATURE_DISPERSION)

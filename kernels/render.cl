@@ -218,14 +218,19 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 #define TREE_SPLIT_ARG
 #endif
 
-/* Traces the pending branches on the stack, depth first, until it is empty; returns the
- * radiance they carry to the sample. White rays that split record it in rec (may be 0). */
+/* Traces the pending branches on the stack, depth first, until it is empty or the tree has
+ * traced VBCL_TREE_MAX_RAYS; returns the radiance they carry to the sample. White rays that
+ * split record it in rec (may be 0). */
 VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share, TreeCount *cnt,
                           TraceCount *tc, ShadowCount *shc, __global VbSplitSet *rec)
 {
     __constant const VbFrame *f = sc->f;
     float3 acc = (float3)(0.0f);
-    while (n > 0) {
+    for (uint traced = 0; n > 0; traced++) {
+        if (traced == VBCL_TREE_MAX_RAYS) { /* the tree's budget: the rest is not traced */
+            cnt->tree_cut += (uint)n;
+            break;
+        }
         TreeRay tr = stack[--n];
         VbMedium state = tr.medium;
         PathHit ph;
@@ -260,6 +265,7 @@ VB_INLINE void tree_flush_counts(__global uint *counters, const TreeCount *cnt,
     atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], cnt->passes);
     atomic_add(&counters[VBCL_COUNT_INTERFACES], cnt->interfaces);
     atomic_add(&counters[VBCL_COUNT_ENERGY_ERRORS], cnt->energy_errors);
+    if (cnt->tree_cut) atomic_add(&counters[VBCL_COUNT_TREE_CUT], cnt->tree_cut);
 #ifdef VBCL_HAS_DISPERSION
     if (cnt->splits) atomic_add(&counters[VBCL_COUNT_SPLITS], cnt->splits);
     if (cnt->band_rays) atomic_add(&counters[VBCL_COUNT_BAND_RAYS], cnt->band_rays);

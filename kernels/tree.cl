@@ -38,6 +38,7 @@ typedef struct TreeRay {
 typedef struct TreeCount {
     uint reflected, transmitted, pruned, depth_cut, tir, passes, interfaces, energy_errors;
     uint splits, band_rays;
+    uint tree_cut; /* branches left when the tree reached VBCL_TREE_MAX_RAYS */
     uint by_depth[VBCL_COUNT_DEPTH_BINS];
     float prune_budget; /* weight this sample may still drop: starts at min_weight */
 } TreeCount;

@@ -80,13 +80,19 @@
     X(SHADOW_UNNEEDED, 15, shadow_unneeded, rays,     "shadow_unneeded")  /* BRDF gives 0 */  \
     X(SHADOW_CLEAR,    16, shadow_clear,    rays,     "shadow_clear")     /* cone meets nothing */ \
     X(SHADOW_BLOCKED,  17, shadow_blocked,  rays,     "shadow_blocked")   /* solid core */        \
-    X(SHADOW_PENUMBRA, 18, shadow_penumbra, rays,     "shadow_penumbra")  /* more in penumbra */
+    X(SHADOW_PENUMBRA, 18, shadow_penumbra, rays,     "shadow_penumbra")  /* more in penumbra */ \
+    X(TREE_CUT,        19, tree_cut,        ray_tree, "tree_cut")         /* over TREE_MAX_RAYS */
 /* clang-format on */
 #define VBCL_COUNTER_INDEX(name, index, field, group, key) VBCL_COUNT_##name = (index),
 enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
-#define VBCL_COUNT_DEPTH0     19 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
+#define VBCL_COUNT_DEPTH0     20 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS 16
-#define VBCL_COUNTERS         35
+#define VBCL_COUNTERS         36
+/* The most rays one sample's ray tree traces (tree_run): a tree that reaches it leaves its
+ * pending branches untraced, counted as tree_cut. Deep trees without pruning between
+ * several dielectrics can hold 2^max_depth rays; every example scene's trees stay far
+ * below this. */
+#define VBCL_TREE_MAX_RAYS 4096
 
 /* A ray work item: from the camera, or a secondary ray. */
 typedef struct VbRay {

@@ -298,8 +298,9 @@ static void test_faults_damaged_texture_cache(void)
 }
 
 /* Messages that name the real cause: no OpenCL platform at all (an empty vendors
- * directory for the ICD loader), on stderr also for --list-devices; a bad VBCL_DEVICE
- * named as itself, not as --device. */
+ * directory for the ICD loader), on stderr also for --list-devices; a descriptor limit
+ * too small to load the driver (it said "no OpenCL platform"); a bad VBCL_DEVICE named as
+ * itself, not as --device. */
 static void test_faults_device_messages(void)
 {
     const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
@@ -318,6 +319,12 @@ static void test_faults_device_messages(void)
     rc = tu_run(cmd, out, sizeof out);
     CHECK(rc == 1 && strstr(out, "no OpenCL platform"),
           "a render with no platform: exit 1 naming the cause (%d): %s", rc, out);
+    /* a descriptor limit so small that the driver cannot be loaded: said as such */
+    snprintf(cmd, sizeof cmd, "bash -c 'ulimit -n 4; exec %s %s -q -o %s/none.pfm'", tu_vbcl, scene,
+             empty);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "descriptor limit, ulimit -n, is 4"),
+          "ulimit -n 4: the descriptor limit named (%d): %s", rc, out);
     snprintf(cmd, sizeof cmd, "VBCL_DEVICE=nosuchdevice %s %s -q -o %s/none.pfm", tu_vbcl, scene,
              empty);
     rc = tu_run(cmd, out, sizeof out);
@@ -367,6 +374,40 @@ static void test_faults_image_helper(void)
     free(pix);
 }
 
+/* A ray tree without bound: max_depth 64 with min_weight 0 between two glass slabs (2^64
+ * rays a sample; the build before the cap did not finish 64 x 64 in 120 s). Each sample's
+ * tree stops at VBCL_TREE_MAX_RAYS: the render ends, counts the branches left
+ * (ray_tree.tree_cut) and warns. */
+static void test_faults_unbounded_tree(void)
+{
+    const char *scene = tu_write_file(
+        "fault_slabs.json",
+        "{\"image\": {\"width\": 32, \"height\": 32},\n"
+        " \"camera\": {\"eye\": [0, 0, 6], \"look_at\": [0, 0, 0]},\n"
+        " \"render\": {\"max_depth\": 64, \"min_weight\": 0},\n"
+        " \"materials\": {\"glass\": {\"k_local\": 0, \"k_global\": 1, \"eta\": 1.5}},\n"
+        " \"objects\": [{\"shape\": \"box\", \"size\": [3, 3, 0.5], \"material\": \"glass\",\n"
+        "               \"transform\": {\"translate\": [0, 0, 1]}},\n"
+        "              {\"shape\": \"box\", \"size\": [3, 3, 0.5], \"material\": \"glass\",\n"
+        "               \"transform\": {\"translate\": [0, 0, -1]}}]}\n");
+    const char *dir = fault_dir("tree");
+    char cmd[4096], out[4096], json[1024];
+    snprintf(json, sizeof json, "%s/slabs.json", dir);
+    snprintf(cmd, sizeof cmd, "timeout 120 %s %s -o %s/slabs.pfm --stats-json %s", tu_vbcl, scene,
+             dir, json);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "ray-tree branches were not traced"),
+          "depth 64 unpruned between two slabs: finishes and warns (%d): %s", rc, out);
+    char text[1 << 16] = "";
+    FILE *f = fopen(json, "rb");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = 0;
+    const char *cut = strstr(text, "\"tree_cut\":");
+    CHECK(cut && atof(cut + strlen("\"tree_cut\":")) > 0, "ray_tree.tree_cut counted: %.80s",
+          cut ? cut : text);
+}
+
 void suite_faults(void)
 {
     RUN_TEST(test_faults_file_size_limit);
@@ -376,4 +417,5 @@ void suite_faults(void)
     RUN_TEST(test_faults_damaged_texture_cache);
     RUN_TEST(test_faults_device_messages);
     RUN_TEST(test_faults_image_helper);
+    RUN_TEST(test_faults_unbounded_tree);
 }
