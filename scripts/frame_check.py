@@ -54,8 +54,8 @@ def scene(scale, shift):
         "objects": [
             {"shape": "box", "size": [6, 0.2, 6], "material": "floor",
              "transform": xf(1, [0, -1.1, 0])},
-            {"shape": "sphere", "level": 4, "material": "glass",
-             "transform": xf(1, [0, 0, 0]),
+            {"shape": "sphere", "level": 4, "material": "glass",  # placed by its centre
+             "radius": scale, "centre": p([0, 0, 0]),
              "texture": {"generate": "bomb --count 12 --size 10:22 --seed 5 --no-overlap "
                                      "--level 2", "material": "inner"}},
         ],

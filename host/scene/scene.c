@@ -175,8 +175,8 @@ void scene_frame_pick(Scene *s, const double eye[3], const double look_at[3])
     d = sqrt(d);
     far = sqrt(far);
     s->frame_scale = 1.0f;
-    if (d < SCENE_FRAME_MIN_VIEW || d > SCENE_FRAME_MAX_VIEW)
-        s->frame_scale = (float)exp2(-round(log2(d)));
+    if (d < SCENE_FRAME_MIN_VIEW || d > SCENE_FRAME_MAX_VIEW) /* 2^-64 .. 2^64: finite */
+        s->frame_scale = (float)exp2(fmin(fmax(-round(log2(d)), -64.0), 64.0));
     for (int k = 0; k < 3; k++)
         s->frame_origin[k] = far > SCENE_FRAME_FAR_VIEWS * d ? look_at[k] : 0;
     s->eye = scene_frame_point(s, eye);
@@ -429,6 +429,8 @@ static int load_lights(Ctx *c, const cJSON *j, Scene *s)
         /* intensity I = flux / 4 pi; a sphere of uniform radiance L has I = L pi r^2 */
         double I = intensity > 0 ? intensity : flux / (4.0 * M_PI);
         double scale = radius > 0 ? I / (M_PI * (double)radius * radius) : I;
+        if (!isfinite(centre.x + centre.y + centre.z) || !isfinite(radius * s->frame_scale))
+            return scene_fail(c, p, "the light lies beyond a float's range in the camera's frame");
         VbLight *l = &s->lights[i];
         l->centre[0] = centre.x; /* in the frame; the radiance stays, as (r / d)^2 does */
         l->centre[1] = centre.y;

@@ -69,6 +69,7 @@ static int load_object(Ctx *c, const cJSON *o, const char *p, int i, Scene *s)
     if (scene_load_shape(c, o, p, shape->valuestring, s, &m) ||
         scene_load_transform_framed(c, o, p, s, &xf))
         goto done;
+    if (strcmp(shape->valuestring, "sphere") == 0) scene_sphere_transform(o, s, &xf);
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "texture");
     if (t) {
         json_path_key(q, p, "texture");

@@ -23,6 +23,9 @@ int scene_load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf);
  * origin in double, as written, so that an object far from (0, 0, 0) keeps its digits. */
 int scene_load_transform_framed(Ctx *c, const cJSON *obj, const char *path, const Scene *s,
                                 mat4 *xf);
+/* A sphere's radius and centre (objects[i] o, checked by its shape) put into xf, its centre
+ * as written, in double, where s's frame is not the file's own (else its mesh has them). */
+void scene_sphere_transform(const cJSON *o, const Scene *s, mat4 *xf);
 /* The point obj[key] (checked as json_get_vec3 does; def when absent) in s's frame, from the
  * numbers as written (double). */
 int scene_get_point(Ctx *c, const cJSON *obj, const char *path, const char *key, const float *def,

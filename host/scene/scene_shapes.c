@@ -44,6 +44,18 @@ int scene_load_transform(Ctx *c, const cJSON *obj, const char *path, mat4 *xf)
     return 0;
 }
 
+void scene_sphere_transform(const cJSON *o, const Scene *s, mat4 *xf)
+{
+    if (scene_frame_is_identity(s)) return; /* load_sphere placed it */
+    double ctr[3];
+    json_numbers(cJSON_GetObjectItemCaseSensitive(o, "centre"), v3(0.0f, 0.0f, 0.0f), ctr);
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(o, "radius");
+    float radius = cJSON_IsNumber(r) ? (float)r->valuedouble : 1.0f; /* checked: > 0 */
+    mat4 place = mat4_scale(v3(radius, radius, radius));
+    for (int k = 0; k < 3; k++) place.m[k][3] = ctr[k];
+    *xf = mat4_mul(*xf, place);
+}
+
 int scene_load_transform_framed(Ctx *c, const cJSON *obj, const char *path, const Scene *s,
                                 mat4 *xf)
 {
@@ -53,12 +65,10 @@ int scene_load_transform_framed(Ctx *c, const cJSON *obj, const char *path, cons
     vec3 parsed = v3(xf->m[0][3], xf->m[1][3], xf->m[2][3]);
     double tr[3];
     json_numbers(t ? cJSON_GetObjectItemCaseSensitive(t, "translate") : NULL, parsed, tr);
-    vec3 moved = scene_frame_point(s, tr); /* scale * (translate - origin), in double */
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) xf->m[i][j] *= s->frame_scale; /* a power of two: exact */
-    xf->m[0][3] = moved.x;
-    xf->m[1][3] = moved.y;
-    xf->m[2][3] = moved.z;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) xf->m[i][j] *= s->frame_scale;   /* a power of two: exact */
+        xf->m[i][3] = (tr[i] - s->frame_origin[i]) * s->frame_scale; /* double, as written */
+    }
     return 0;
 }
 
@@ -127,8 +137,10 @@ static int load_mesh_file(Ctx *c, const cJSON *o, const char *p, const Scene *s,
     return 0;
 }
 
-/* objects[i] with "shape": "sphere": a subdivided icosahedron of radius and centre. */
-static int load_sphere(Ctx *c, const cJSON *o, const char *p, Mesh *m)
+/* objects[i] with "shape": "sphere": a subdivided icosahedron of radius and centre. In a
+ * scene whose frame is not the file's own the unit icosahedron is left as it is, and the
+ * object's transform places it (scene_sphere_transform), in double. */
+static int load_sphere(Ctx *c, const cJSON *o, const char *p, const Scene *s, Mesh *m)
 {
     static const char *const keys[] = {"shape",  "material", "name",  "transform", "texture",
                                        "radius", "centre",   "level", NULL};
@@ -141,6 +153,7 @@ static int load_sphere(Ctx *c, const cJSON *o, const char *p, Mesh *m)
         json_get_int(c, o, p, "level", 0, 7, 3, 0, &level))
         return -1;
     if (shape_sphere(m, level)) return 1;
+    if (!scene_frame_is_identity(s)) return 0;
     mat4 xf = mat4_mul(mat4_translate(v3(centre[0], centre[1], centre[2])),
                        mat4_scale(v3(radius, radius, radius)));
     mesh_transform(m, &xf);
@@ -198,7 +211,7 @@ int scene_load_shape(Ctx *c, const cJSON *o, const char *p, const char *shape, c
     if (strcmp(shape, "mesh") == 0) return load_mesh_file(c, o, p, s, m);
     if (strcmp(shape, "revolution") == 0) return load_revolution(c, o, p, m);
     if (strcmp(shape, "sphere") == 0)
-        rc = load_sphere(c, o, p, m);
+        rc = load_sphere(c, o, p, s, m);
     else if (strcmp(shape, "box") == 0 || strcmp(shape, "quad") == 0)
         rc = load_box_or_quad(c, o, p, shape[0] == 'q', m);
     else if (strcmp(shape, "prism") == 0)
