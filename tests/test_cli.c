@@ -64,16 +64,6 @@ static double json_num(const cJSON *o, ...)
     return cJSON_IsNumber(o) ? o->valuedouble : NAN;
 }
 
-/* Whether dir holds a file whose name contains part. */
-static int dir_has(const char *dir, const char *part)
-{
-    DIR *d = opendir(dir);
-    int found = 0;
-    for (struct dirent *e; d && (e = readdir(d));) found |= strstr(e->d_name, part) != NULL;
-    if (d) closedir(d);
-    return found;
-}
-
 static void test_cli_help_and_usage(void)
 {
     char out[8192];
@@ -1209,7 +1199,7 @@ static void test_cli_stats_json(void)
     snprintf(args, sizeof args, "%s -q -o %s --stats-json %s", scene, img, dir);
     rc = vbcl(args, out, sizeof out);
     CHECK(rc == 1 && strstr(out, "statsdir"), "unwritable path: exit 1 (%d): %s", rc, out);
-    CHECK(!dir_has(tu_tmpdir(), ".statsdir.tmp"), "no temporary file left beside it");
+    CHECK(!tu_dir_has(tu_tmpdir(), ".statsdir.tmp"), "no temporary file left beside it");
 }
 
 /* What a user of another renderer types: the nearest valid key or option is suggested

@@ -24,16 +24,6 @@
 /* The old file every case puts at the path first: it must be there, the same, after. */
 #define OLD_TEXT "an older output, kept whole\n"
 
-/* Whether dir holds a file whose name contains part. */
-static int dir_has(const char *dir, const char *part)
-{
-    DIR *d = opendir(dir);
-    int found = 0;
-    for (struct dirent *e; d && (e = readdir(d));) found |= strstr(e->d_name, part) != NULL;
-    if (d) closedir(d);
-    return found;
-}
-
 /* Puts OLD_TEXT at path. */
 static void put_old(const char *path)
 {
@@ -101,7 +91,7 @@ static void test_faults_file_size_limit(void)
     CHECK(rc == 1 && strstr(out, path) && strstr(out, "File too large"),
           "over the file-size limit: exit 1 naming the file and the cause (%d): %s", rc, out);
     CHECK(old_intact(path), "the older file is intact");
-    CHECK(!dir_has(dir, ".tmp"), "no temporary left");
+    CHECK(!tu_dir_has(dir, ".tmp"), "no temporary left");
     /* vbcl texgen opens no OpenCL device: a limit of 8 KiB, and its images (every format,
      * 15 - 210 KB at 256 x 256) and meshes (440 KB) */
     static const char *const texgen[] = {
@@ -119,7 +109,7 @@ static void test_faults_file_size_limit(void)
               "texgen %s over the limit: exit 1 naming the file and the cause (%d): %s", targs, rc,
               out);
         CHECK(old_intact(path), "texgen %s: the older file is intact", targs);
-        CHECK(!dir_has(dir, ".tmp"), "texgen %s: no temporary left", targs);
+        CHECK(!tu_dir_has(dir, ".tmp"), "texgen %s: no temporary left", targs);
     }
 }
 
@@ -150,7 +140,7 @@ static void test_faults_full_disk(void)
         CHECK(rc == 1 && strstr(out, path) && strstr(out, "No space left on device"),
               "%s on a full disk: exit 1 naming the file and the cause (%d): %s", ext, rc, out);
         CHECK(old_intact(path), "%s: the older file is intact", ext);
-        CHECK(!dir_has(dir, ".tmp"), "%s: no temporary left", ext);
+        CHECK(!tu_dir_has(dir, ".tmp"), "%s: no temporary left", ext);
     }
     snprintf(cmd, sizeof cmd, "umount '%s'", dir);
     tu_run(cmd, NULL, 0);
@@ -164,6 +154,14 @@ static const char *shim_path(void)
     snprintf(path, sizeof path, "%.*slibvbcl_fault.so", slash ? (int)(slash - tu_vbcl + 1) : 0,
              tu_vbcl);
     return path;
+}
+
+/* Whether the shim is there (a failed check when it is not). */
+static int shim_ready(void)
+{
+    int ok = access(shim_path(), R_OK) == 0;
+    CHECK(ok, "the fault shim %s is missing (make builds it with the tests)", shim_path());
+    return ok;
 }
 
 /* Runs vbcl with args under the fault shim (fault on files whose path holds part), with
@@ -184,10 +182,7 @@ static int run_faulty(const char *fault, const char *part, const char *args, cha
  * there): exit 1 with the cause, for every output. */
 static void test_faults_sync_fails(void)
 {
-    if (access(shim_path(), R_OK)) {
-        CHECK(0, "the fault shim %s is missing (make builds it with the tests)", shim_path());
-        return;
-    }
+    if (!shim_ready()) return;
     const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
     const char *dir = fault_dir("sync");
     char args[2048], out[4096], path[1024];
@@ -203,7 +198,7 @@ static void test_faults_sync_fails(void)
               "%s, %s at the sync: exit 1 naming the file and the cause (%d): %s", ext, fault, rc,
               out);
         CHECK(old_intact(path), "%s: the older file is intact", ext);
-        CHECK(!dir_has(dir, ".tmp"), "%s: no temporary left", ext);
+        CHECK(!tu_dir_has(dir, ".tmp"), "%s: no temporary left", ext);
     }
 }
 
@@ -211,10 +206,7 @@ static void test_faults_sync_fails(void)
  * removed, the older file is whole. */
 static void test_faults_signal_in_write(void)
 {
-    if (access(shim_path(), R_OK)) {
-        CHECK(0, "the fault shim %s is missing (make builds it with the tests)", shim_path());
-        return;
-    }
+    if (!shim_ready()) return;
     const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
     const char *dir = fault_dir("signal");
     static const struct {
@@ -231,7 +223,7 @@ static void test_faults_signal_in_write(void)
         CHECK(rc == 128 + cases[i].sig, "SIG%s in the write of %s: died of it (%d): %s",
               cases[i].name, cases[i].ext, rc, out);
         CHECK(old_intact(path), "SIG%s: the older file is intact", cases[i].name);
-        CHECK(!dir_has(dir, ".tmp"), "SIG%s: no temporary left", cases[i].name);
+        CHECK(!tu_dir_has(dir, ".tmp"), "SIG%s: no temporary left", cases[i].name);
     }
 }
 

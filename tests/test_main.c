@@ -1,4 +1,5 @@
 /* test_main.c — runs every suite; usage: vbcl-tests [--vbcl PATH] [NAME-FILTER]. */
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,6 +50,15 @@ int tu_run(const char *cmd, char *out, size_t outlen)
     int st = pclose(p);
     if (st == -1) return -1;
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+int tu_dir_has(const char *dir, const char *part)
+{
+    DIR *d = opendir(dir);
+    int found = 0;
+    for (struct dirent *e; d && (e = readdir(d));) found |= strstr(e->d_name, part) != NULL;
+    if (d) closedir(d);
+    return found;
 }
 
 const char *tu_tmpdir(void)

@@ -32,6 +32,18 @@ static const char *write_image(void)
     return path;
 }
 
+/* n points (xyz + 0) in [-half, half)^3 from a linear congruential sequence from seed. */
+static void random_points(float *pts, int n, unsigned seed, float half)
+{
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            pts[4 * i + k] = (float)(seed >> 8) / 16777216.0f * 2.0f * half - half;
+        }
+        pts[4 * i + 3] = 0;
+    }
+}
+
 #define PATTERN_SCENE                                                                              \
     "{\"camera\": {\"eye\": [0.5, 0.5, 5], \"look_at\": [0.5, 0.5, 0], \"fov\": 12},"              \
     " \"image\": {\"width\": 40, \"height\": 20},"                                                 \
@@ -59,14 +71,7 @@ static void test_patterns_probe_matches_host(void)
     if (fixture_open(&fx, json)) return;
     enum { N = 64 };
     float pts[N * 4], out[N * 4];
-    unsigned seed = 5;
-    for (int i = 0; i < N; i++) {
-        for (int k = 0; k < 3; k++) {
-            seed = seed * 1664525u + 1013904223u;
-            pts[4 * i + k] = (float)(seed >> 8) / 16777216.0f * 6.0f - 3.0f;
-        }
-        pts[4 * i + 3] = 0;
-    }
+    random_points(pts, N, 5, 3.0f);
     cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
     int n = N, mat = 1; /* "g" */
     const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
@@ -172,14 +177,7 @@ static void test_patterns_checker(void)
     if (fixture_open(&fx, json)) return;
     enum { N = 256 };
     float pts[N * 4], out[N * 4];
-    unsigned seed = 11;
-    for (int i = 0; i < N; i++) {
-        for (int k = 0; k < 3; k++) {
-            seed = seed * 1664525u + 1013904223u;
-            pts[4 * i + k] = (float)(seed >> 8) / 16777216.0f * 8.0f - 4.0f;
-        }
-        pts[4 * i + 3] = 0;
-    }
+    random_points(pts, N, 11, 4.0f);
     cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
     const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
     int n = N;

@@ -23,6 +23,9 @@ const char *tu_tmpdir(void);
 /* Writes text to dir/name and returns the full path in a static buffer ring. */
 const char *tu_write_file(const char *name, const char *text);
 
+/* Whether directory dir holds a file whose name contains part. */
+int tu_dir_has(const char *dir, const char *part);
+
 /* Suites, one per test file. */
 void suite_mesh(void);
 void suite_grid_build(void);
