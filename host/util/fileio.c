@@ -92,16 +92,22 @@ static void temp_end(int slot, int keep)
     pthread_mutex_unlock(&temps_lock);
 }
 
+/* path's directory into dir ("." for a bare name); 0, or -1 when it does not fit. */
+static int dir_of(const char *path, char *dir, size_t n)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash) return snprintf(dir, n, ".") < 0 ? -1 : 0;
+    if ((size_t)(slash - path) >= n) return -1;
+    snprintf(dir, n, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    return 0;
+}
+
 /* Makes the rename of a file in path's directory durable (best effort: some filesystems
  * cannot sync a directory). */
 static void sync_dir(const char *path)
 {
-    const char *slash = strrchr(path, '/');
     char dir[4096];
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else
-        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    if (dir_of(path, dir, sizeof dir)) return;
     int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd >= 0) {
         fsync(fd);
@@ -166,15 +172,11 @@ int file_write_whole(const char *path, const void *data, size_t n, char *err, si
 
 int file_check_dir(const char *path, char *err, size_t errlen)
 {
-    const char *slash = strrchr(path, '/');
     char dir[4096];
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if ((size_t)(slash - path) >= sizeof dir) {
+    if (dir_of(path, dir, sizeof dir)) {
         snprintf(err, errlen, "%s: path too long", path);
         return -1;
-    } else
-        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    }
     if (access(dir, W_OK | X_OK) != 0) {
         int e = errno;
         snprintf(err, errlen, "%s: cannot write there: %s%s", path, strerror(e),

@@ -283,7 +283,7 @@ static int helper_encode(const char *path, int width, int height, const float *r
             snprintf(err, errlen, "%s: out of memory for the encoded image (%llu bytes)", path,
                      (unsigned long long)a.bytes);
             rc = -1;
-            helper.fd = (close(helper.fd), -1); /* its reply cannot be read: end it */
+            helper.stuck = 1; /* its reply cannot be read: it is ended (and reaped) below */
         } else if (!(s = sock_all_within(helper.fd, msg, a.err_len, 0, t)) &&
                    !(s = sock_all_within(helper.fd, data, (size_t)a.bytes, 0, t))) {
             msg[a.err_len] = 0;
@@ -302,8 +302,9 @@ static int helper_encode(const char *path, int width, int height, const float *r
                    "encodes %s itself",
                    (long)helper.pid, t / 1000, path);
     }
+    int end = rc == -2 || helper.stuck;
     pthread_mutex_unlock(&helper_lock);
-    if (rc == -2) helper_stop(); /* gone or stuck: not asked again */
+    if (end) helper_stop(); /* gone or stuck: not asked again */
     return rc;
 }
 
