@@ -177,11 +177,13 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 # (scripts/bench.py --quick) and scripts/bench_rays_compare.py on one, so that `make gallery`,
 # `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
 # mean nothing.
+# The tests run in TEST_JOBS worker processes (vbcl-tests -j), one a core up to 4 by default.
+TEST_JOBS ?= $(shell n=$$(nproc); echo $$((n < 4 ? n : 4)))
 test:
 	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays \
 	    $(BUILD)/libvbcl_fault.so
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache
-	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests --vbcl $(BUILD)/vbcl
+	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests -j $(TEST_JOBS) --vbcl $(BUILD)/vbcl
 ifeq ($(SANITIZE),)
 	$(Q)scripts/gallery.py --vbcl $(BUILD)/vbcl --size 16 --scenes a1,a6 --out $(BUILD)/gallery-quick \
 	  > $(BUILD)/gallery-quick.log 2>&1 && echo "gallery --size 16: ran (A.1, A.6)" \

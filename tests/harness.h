@@ -28,7 +28,20 @@ void th_skip(const char *why);
 /* Runs only tests whose name contains f (NULL: all). */
 void th_set_filter(const char *f);
 
-/* Prints "N passed, N failed[, N skipped]" and returns the exit status (1 if any failed). */
+/* Runs the tests in `jobs` worker processes (at most TH_MAX_JOBS; fewer than 2: in this
+ * one, and it returns). Each worker is this program again (argv with "--worker K FD" after
+ * argv[0], FD the shared counts); it walks every suite and takes each test no other worker
+ * has taken, so a long test holds one worker while the others go on, and a test's output is
+ * written whole when it ends. The caller, the parent, waits for the workers, names any that
+ * crashed and the test it was in, prints the summary and exits (1 if any test failed). */
+#define TH_MAX_JOBS 16
+void th_parallel(int jobs, char **argv);
+
+/* Makes this process worker k of th_parallel, sharing counts through fd; -1 on failure. */
+int th_worker(int k, int fd);
+
+/* Prints "N passed, N failed[, N skipped]" and returns the exit status (1 if any failed);
+ * in a worker it prints nothing and returns 0 (the parent prints the summary). */
 int th_summary(void);
 
 #endif

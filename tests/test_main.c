@@ -1,4 +1,4 @@
-/* test_main.c — runs every suite; usage: vbcl-tests [--vbcl PATH] [NAME-FILTER]. */
+/* test_main.c — runs every suite; usage: vbcl-tests [--vbcl PATH] [-j JOBS] [NAME-FILTER]. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -99,12 +99,23 @@ static void cleanup(void)
 
 int main(int argc, char **argv)
 {
+    int jobs = 1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--vbcl") && i + 1 < argc)
             tu_vbcl = argv[++i];
-        else
+        else if (!strcmp(argv[i], "-j") && i + 1 < argc)
+            jobs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--worker") && i + 2 < argc) {
+            if (th_worker(atoi(argv[i + 1]), atoi(argv[i + 2]))) {
+                fprintf(stderr, "vbcl-tests: --worker %s %s: no shared counts\n", argv[i + 1],
+                        argv[i + 2]);
+                return 2;
+            }
+            i += 2;
+        } else
             th_set_filter(argv[i]);
     }
+    th_parallel(jobs, argv);
     atexit(cleanup);
     suite_mesh();
     suite_grid_build();

@@ -3,8 +3,10 @@
  * or kernels/ over 80 lines without a reason written above it. The checker is first shown
  * to catch both on a small tree of its own. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "testutil.h"
@@ -63,8 +65,60 @@ static void test_structure_of_the_project(void)
     CHECK(rc == 0, "scripts/check_structure.py (exit %d):\n%s", rc, out);
 }
 
+/* Sorts the "ok/FAIL/skip NAME" lines of a run's output, times cut off, into out. */
+static void result_lines(const char *text, char *out, size_t n)
+{
+    char lines[64][128];
+    int k = 0;
+    for (const char *p = text; *p && k < 64;) {
+        const char *e = strchr(p, '\n');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (!strncmp(p, "ok   ", 5) || !strncmp(p, "FAIL ", 5) || !strncmp(p, "skip ", 5)) {
+            const char *t = memchr(p, '(', len);
+            snprintf(lines[k++], sizeof lines[0], "%.*s", (int)((t ? t : p + len) - p), p);
+        }
+        p += len + (e != NULL);
+    }
+    qsort(lines, (size_t)k, sizeof lines[0], (int (*)(const void *, const void *))strcmp);
+    out[0] = 0;
+    for (int i = 0; i < k; i++) snprintf(out + strlen(out), n - strlen(out), "%s\n", lines[i]);
+}
+
+/* The last line of a run's output (its summary) into out. */
+static void last_line(const char *text, char *out, size_t n)
+{
+    size_t len = strlen(text);
+    while (len > 0 && text[len - 1] == '\n') len--;
+    size_t start = len;
+    while (start > 0 && text[start - 1] != '\n') start--;
+    snprintf(out, n, "%.*s", (int)(len - start), text + start);
+}
+
+/* vbcl-tests -j 2 runs the same tests as one process, each once, with the same summary. */
+static void test_harness_workers(void)
+{
+    static char one[16384], two[16384];
+    char a[4096], b[4096], sa[128], sb[128], self[1024], cmd[1200];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    CHECK(n > 0, "cannot read /proc/self/exe");
+    if (n <= 0) return;
+    self[n] = 0;
+    snprintf(cmd, sizeof cmd, "'%s' mesh", self);
+    int rc1 = tu_run(cmd, one, sizeof one);
+    snprintf(cmd, sizeof cmd, "'%s' -j 2 mesh", self);
+    int rc2 = tu_run(cmd, two, sizeof two);
+    result_lines(one, a, sizeof a);
+    result_lines(two, b, sizeof b);
+    last_line(one, sa, sizeof sa);
+    last_line(two, sb, sizeof sb);
+    CHECK(rc1 == 0 && rc2 == 0 && a[0] && !strcmp(a, b) && strstr(sa, " passed, 0 failed") &&
+              !strcmp(sa, sb),
+          "one process (exit %d):\n%s\ntwo workers (exit %d):\n%s", rc1, one, rc2, two);
+}
+
 void suite_structure(void)
 {
+    RUN_TEST(test_harness_workers);
     RUN_TEST(test_structure_checker_catches);
     RUN_TEST(test_structure_of_the_project);
 }
