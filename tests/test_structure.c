@@ -98,14 +98,14 @@ static void last_line(const char *text, char *out, size_t n)
 static void test_harness_workers(void)
 {
     static char one[16384], two[16384];
-    char a[4096], b[4096], sa[128], sb[128], self[1024], cmd[1200];
+    char a[4096], b[4096], sa[128], sb[128], self[1024], cmd[2400];
     ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
     CHECK(n > 0, "cannot read /proc/self/exe");
     if (n <= 0) return;
     self[n] = 0;
-    snprintf(cmd, sizeof cmd, "'%s' mesh", self);
+    snprintf(cmd, sizeof cmd, "'%s' --vbcl '%s' mesh", self, tu_vbcl);
     int rc1 = tu_run(cmd, one, sizeof one);
-    snprintf(cmd, sizeof cmd, "'%s' -j 2 mesh", self);
+    snprintf(cmd, sizeof cmd, "'%s' --vbcl '%s' -j 2 mesh", self, tu_vbcl);
     int rc2 = tu_run(cmd, two, sizeof two);
     result_lines(one, a, sizeof a);
     result_lines(two, b, sizeof b);
