@@ -28,20 +28,13 @@
 #define VB_PI 3.14159265358979323846f
 
 /* Hot helpers must be inlined: on CPU drivers a call passes structs through the stack
- * and every counter update becomes a store and a reload. VB_CALLED marks the few that are
- * called instead where the host asks for it (VBCL_CALLS: drivers that compile each kernel
- * at its first launch, PoCL), to cut that compile; elsewhere they are inlined too (Intel's
- * CPU runtime 2026.2 miscompiles the call: docs/architecture.md, "Kernel programs"). */
+ * and every counter update becomes a store and a reload (a called medium_trace cost
+ * prism_dispersion 11% of its kernel time on PoCL; docs/architecture.md, "Kernel
+ * programs"). */
 #ifdef __clang__
 #define VB_INLINE inline __attribute__((always_inline))
-#ifdef VBCL_CALLS
-#define VB_CALLED __attribute__((noinline))
-#else
-#define VB_CALLED VB_INLINE
-#endif
 #else
 #define VB_INLINE inline
-#define VB_CALLED inline
 #endif
 
 /* float3 from three floats of a host-written array (the shared structs hold float[3]). */

@@ -82,7 +82,7 @@ typedef struct PathHit {
  * to the first interface within tmax, among the triangles of os (os->n < 0: any, through
  * the grid; a set holds for every stretch of the ray). Returns 0 when there is none.
  * camera: a camera ray, whose first search is camera_trace_closest. */
-VB_CALLED int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
+VB_INLINE int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, float3 dir,
                            float tmax, VbMedium *state, PathHit *out, TraceCount *tc, uint *passes,
                            int camera)
 {

@@ -501,11 +501,6 @@ static int driver_is_pocl(const VbDevice *d)
     return strstr(name, "Portable Computing Language") != NULL;
 }
 
-int clu_compiles_at_launch(const VbDevice *d)
-{
-    return driver_is_pocl(d);
-}
-
 /* Whether d's driver keeps compiled kernels of its own between runs: PoCL does, in
  * POCL_CACHE_DIR, unless POCL_KERNEL_CACHE is 0. */
 static int driver_caches_kernels(const VbDevice *d)

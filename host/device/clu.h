@@ -123,11 +123,6 @@ const char *clu_build_how(int how);
 cl_program clu_program_build(VbDevice *d, const char *source, const char *options, double *ms,
                              int *cached);
 
-/* Whether d's driver compiles each kernel at its first launch, from the whole program
- * (PoCL): there the kernels call their biggest walk instead of inlining it (VBCL_CALLS,
- * kernels/compat.h), which cuts that compile. */
-int clu_compiles_at_launch(const VbDevice *d);
-
 /* Whether this program has been compiled on d before, with its kernels launched
  * (clu_program_mark_seen: a stamp in the cache's programs/ folder). */
 int clu_program_seen(const VbDevice *d, const char *source, const char *options);

@@ -63,14 +63,6 @@ void renderer_build_notice(int on)
     build_notice_on = on;
 }
 
-/* Adds to a tracing program's options what d's driver asks for (VBCL_CALLS where it
- * compiles each kernel at its first launch). */
-static void options_for_device(const VbDevice *d, char *options, size_t n)
-{
-    size_t len = strlen(options);
-    if (clu_compiles_at_launch(d) && len < n) snprintf(options + len, n - len, " -DVBCL_CALLS");
-}
-
 /* The film program's build options: it has no features. */
 static const char film_options[] = "-cl-std=CL1.2";
 
@@ -105,7 +97,6 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
     st->program = features_program(r->features);
     r->program_features = features_compiled(r->features);
     features_build_options(r->features, s, st->options, sizeof st->options);
-    options_for_device(r->dev, st->options, sizeof st->options);
     int fresh = !clu_program_seen(r->dev, vbcl_kernel_source, st->options) ||
                 !clu_program_seen(r->dev, vbcl_film_source, film_options);
     if (fresh && build_notice_on) {
@@ -125,7 +116,6 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
         char popt[512];
         int pc;
         features_program_options(PROGRAM_DISPERSIVE, popt, sizeof popt);
-        options_for_device(r->dev, popt, sizeof popt);
         if (renderer_program(r, probe_source, popt, &r->probe, &pc, st)) return 1;
     }
     r->local_size = r->dev->max_wg >= 64 ? 64 : 0;
