@@ -13,13 +13,15 @@
 #include <time.h>
 #include <unistd.h>
 
-enum { TH_MAX_TESTS = 1024, TH_MAX_FAILED = 64, TH_NAME = 96 };
+enum { TH_MAX_TESTS = 1024, TH_MAX_FAILED = 64, TH_NAME = 96, TH_MAX_GROUPS = 16 };
 
 /* What the workers share (an anonymous shared mapping): which tests are taken, the counts,
  * the failed tests' names, what each worker runs, and the lock on the output. */
 typedef struct {
     int claimed[TH_MAX_TESTS];
-    int passed, failed, skipped, out_lock;
+    int passed, failed, skipped, out_lock, group_lock;
+    char groups[TH_MAX_GROUPS][TH_NAME]; /* th_group names, each with its worker */
+    int group_owner[TH_MAX_GROUPS];
     char failed_names[TH_MAX_FAILED][TH_NAME];
     char running[TH_MAX_JOBS][TH_NAME];
 } Shared;
@@ -29,6 +31,7 @@ static int passed, failed, skipped, skipping;
 static const char *filter;
 static Shared *shared; /* NULL: one process */
 static int worker, next_test;
+static const char *group; /* th_group's */
 
 void th_fail(const char *file, int line, const char *expr, const char *fmt, ...)
 {
@@ -104,12 +107,34 @@ static int count(int *mine, int *all)
     return shared ? __atomic_fetch_add(all, 1, __ATOMIC_SEQ_CST) : (*mine)++;
 }
 
+/* Whether this worker runs the tests of group g: the first worker to ask owns it (a table
+ * too full to hold g: worker 0). */
+static int group_mine(const char *g)
+{
+    while (__atomic_exchange_n(&shared->group_lock, 1, __ATOMIC_ACQUIRE)) sched_yield();
+    int owner = 0, k = 0;
+    while (k < TH_MAX_GROUPS && shared->groups[k][0] && strcmp(shared->groups[k], g)) k++;
+    if (k < TH_MAX_GROUPS && !shared->groups[k][0]) {
+        snprintf(shared->groups[k], TH_NAME, "%s", g);
+        shared->group_owner[k] = worker;
+    }
+    if (k < TH_MAX_GROUPS) owner = shared->group_owner[k];
+    __atomic_store_n(&shared->group_lock, 0, __ATOMIC_RELEASE);
+    return owner == worker;
+}
+
+void th_group(const char *name)
+{
+    group = name;
+}
+
 void th_run(const char *name, void (*fn)(void))
 {
     if (filter && !strstr(name, filter)) return;
     int index = next_test++;
     if (shared) { /* the first worker to come to a test takes it; past the table, worker 0 */
-        int mine = index < TH_MAX_TESTS
+        int mine = group ? group_mine(group)
+                   : index < TH_MAX_TESTS
                        ? !__atomic_exchange_n(&shared->claimed[index], 1, __ATOMIC_SEQ_CST)
                        : worker == 0;
         if (!mine) return;

@@ -37,6 +37,11 @@ void th_set_filter(const char *f);
 #define TH_MAX_JOBS 16
 void th_parallel(int jobs, char **argv);
 
+/* Puts the tests run from here on, until th_group(NULL), in group `name`: with workers,
+ * one worker runs all of a group's tests (tests that would otherwise compile the same
+ * kernels at the same time in two workers). */
+void th_group(const char *name);
+
 /* Makes this process worker k of th_parallel, sharing counts through fd; -1 on failure. */
 int th_worker(int k, int fd);
 

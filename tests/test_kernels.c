@@ -1257,6 +1257,7 @@ static void test_light_lobe_cap(void)
 
 void suite_kernels(void)
 {
+    th_group("probe kernels"); /* one worker compiles the probe kernels at their first launch */
     RUN_TEST(test_failed_build_prints_log_and_options);
     RUN_TEST(test_kernel_struct_layout);
     RUN_TEST(test_grid_matches_brute_force);
@@ -1271,4 +1272,5 @@ void suite_kernels(void)
     RUN_TEST(test_light_sole_host);
     RUN_TEST(test_light_cone_flag);
     RUN_TEST(test_rays_at_edges_and_vertices_hit);
+    th_group(NULL);
 }
