@@ -1100,7 +1100,7 @@ void suite_aa(void)
     RUN_TEST(test_aa_options);
     RUN_TEST(test_aa_min_level);
     RUN_TEST(test_aa_samples_nested_never_retraced);
-    RUN_TEST(test_aa_neighbour_rule_across_levels);
-    RUN_TEST(test_aa_resolve_nearest_samples);
-    RUN_TEST(test_aa_dirty_list);
+    RUN_PROBE_TEST(test_aa_neighbour_rule_across_levels);
+    RUN_PROBE_TEST(test_aa_resolve_nearest_samples);
+    RUN_PROBE_TEST(test_aa_dirty_list);
 }

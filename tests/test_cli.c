@@ -1269,11 +1269,11 @@ void suite_cli(void)
     RUN_TEST(test_cli_help_and_usage);
     RUN_TEST(test_cli_suggestions);
     RUN_TEST(test_cli_image_plugin);
-    th_group("program binaries"); /* the first compiles a program's binary, the second reuses it */
+    th_group("program binaries"); /* the first compiles a program's binary, the others reuse it */
     RUN_TEST(test_cli_cache_pruned);
     RUN_TEST(test_cli_cache_binaries);
-    th_group(NULL);
     RUN_TEST(test_cli_damaged_binary);
+    th_group(NULL);
     RUN_TEST(test_cli_compile_notice);
     RUN_TEST(test_cli_list_devices);
     RUN_TEST(test_cli_renders_and_overrides);

@@ -486,9 +486,9 @@ void suite_dispersion(void)
     RUN_TEST(test_dispersion_band_weights_sum_to_white);
     RUN_TEST(test_dispersion_prism_order);
     RUN_TEST(test_dispersion_scene_keys);
-    RUN_TEST(test_dispersion_prism_device);
+    RUN_PROBE_TEST(test_dispersion_prism_device);
     RUN_TEST(test_dispersion_bands_leave_other_paths_alone);
     RUN_TEST(test_dispersion_thesis_model_and_rays);
-    RUN_TEST(test_dispersion_thesis_prism_device);
-    RUN_TEST(test_dispersion_shadow_feelers);
+    RUN_PROBE_TEST(test_dispersion_thesis_prism_device);
+    RUN_PROBE_TEST(test_dispersion_shadow_feelers);
 }

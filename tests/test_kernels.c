@@ -1257,20 +1257,18 @@ static void test_light_lobe_cap(void)
 
 void suite_kernels(void)
 {
-    th_group("probe kernels"); /* one worker compiles the probe kernels at their first launch */
     RUN_TEST(test_failed_build_prints_log_and_options);
-    RUN_TEST(test_kernel_struct_layout);
-    RUN_TEST(test_grid_matches_brute_force);
-    RUN_TEST(test_camera_tiles_match_grid);
-    RUN_TEST(test_grid_cell_box_range);
-    RUN_TEST(test_contact_opaque_surface_first);
-    RUN_TEST(test_light_irradiance_closed_form);
-    RUN_TEST(test_light_feelers_net);
-    RUN_TEST(test_light_lobe_cap);
-    RUN_TEST(test_light_cone_brute);
-    RUN_TEST(test_ray_objects_brute);
-    RUN_TEST(test_light_sole_host);
-    RUN_TEST(test_light_cone_flag);
-    RUN_TEST(test_rays_at_edges_and_vertices_hit);
-    th_group(NULL);
+    RUN_PROBE_TEST(test_kernel_struct_layout);
+    RUN_PROBE_TEST(test_grid_matches_brute_force);
+    RUN_PROBE_TEST(test_camera_tiles_match_grid);
+    RUN_PROBE_TEST(test_grid_cell_box_range);
+    RUN_PROBE_TEST(test_contact_opaque_surface_first);
+    RUN_PROBE_TEST(test_light_irradiance_closed_form);
+    RUN_PROBE_TEST(test_light_feelers_net);
+    RUN_PROBE_TEST(test_light_lobe_cap);
+    RUN_PROBE_TEST(test_light_cone_brute);
+    RUN_PROBE_TEST(test_ray_objects_brute);
+    RUN_PROBE_TEST(test_light_sole_host);
+    RUN_PROBE_TEST(test_light_cone_flag);
+    RUN_PROBE_TEST(test_rays_at_edges_and_vertices_hit);
 }

@@ -117,12 +117,12 @@ int main(int argc, char **argv)
     }
     th_parallel(jobs, argv);
     atexit(cleanup);
+    suite_kernels(); /* first: its probe kernels are the longest compile of a cold run */
     suite_mesh();
     suite_grid_build();
     suite_scene();
     suite_texgen();
     suite_cli();
-    suite_kernels();
     suite_optics();
     suite_patterns();
     suite_stability();

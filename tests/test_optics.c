@@ -566,8 +566,8 @@ static void test_optics_energy_and_closed_hosts(void)
 
 void suite_optics(void)
 {
-    RUN_TEST(test_optics_snell_and_reflection);
-    RUN_TEST(test_optics_fresnel);
+    RUN_PROBE_TEST(test_optics_snell_and_reflection);
+    RUN_PROBE_TEST(test_optics_fresnel);
     RUN_TEST(test_optics_slab_beer_lambert);
     RUN_TEST(test_optics_camera_inside_glass);
     RUN_TEST(test_optics_glass_standing_on_floor);

@@ -210,7 +210,7 @@ static void test_patterns_checker(void)
 
 void suite_patterns(void)
 {
-    RUN_TEST(test_patterns_probe_matches_host);
+    RUN_PROBE_TEST(test_patterns_probe_matches_host);
     RUN_TEST(test_patterns_render_projection);
-    RUN_TEST(test_patterns_checker);
+    RUN_PROBE_TEST(test_patterns_checker);
 }

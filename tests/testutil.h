@@ -44,4 +44,14 @@ void suite_scale(void);
 void suite_faults(void);
 void suite_frame(void);
 
+/* A test that runs probe kernels (tests/fixture.c): with workers (vbcl-tests -j), all such
+ * tests run in one worker, which compiles each probe kernel once at its first launch while
+ * the others run the rest (th_group). */
+#define RUN_PROBE_TEST(fn)                                                                         \
+    do {                                                                                           \
+        th_group("probe kernels");                                                                 \
+        th_run(#fn, fn);                                                                           \
+        th_group(NULL);                                                                            \
+    } while (0)
+
 #endif
