@@ -173,28 +173,25 @@ run:
 # ("Tracer caught signal 11") on a run with no leak. Dynamic TLS blocks are malloc'd and
 # reached from each thread's DTV, so the leak check does not need the interceptor.
 SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0)
-# Then the gallery script on two figures at 16x16, every benchmark part on tiny images
-# (scripts/bench.py --quick) and scripts/bench_rays_compare.py on one, so that `make gallery`,
-# `make bench` and the comparison script cannot rot; not in sanitizer builds, whose timings
-# mean nothing.
-# The tests run in TEST_JOBS worker processes (vbcl-tests -j), one a core up to 4 by default.
+# Beside the tests, scripts/smoke.sh: the gallery script on two figures at 16x16, every
+# benchmark part on tiny images (scripts/bench.py --quick) and scripts/bench_rays_compare.py
+# on one, so that `make gallery`, `make bench` and the comparison script cannot rot; not in
+# sanitizer builds, whose timings mean nothing. The tests run in TEST_JOBS worker processes
+# (vbcl-tests -j), one a core up to 4 by default; --warm-cache compiles the kernels while
+# the test binaries build.
 TEST_JOBS ?= $(shell n=$$(nproc); echo $$((n < 4 ? n : 4)))
 test:
-	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl $(BUILD)/vbcl-bench-rays \
-	    $(BUILD)/libvbcl_fault.so
-	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache
-	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests -j $(TEST_JOBS) --vbcl $(BUILD)/vbcl
+	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl
+	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache & warm=$$!; \
+	  $(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl-bench-rays \
+	    $(BUILD)/libvbcl_fault.so; built=$$?; \
+	  wait $$warm && [ $$built = 0 ]
 ifeq ($(SANITIZE),)
-	$(Q)scripts/gallery.py --vbcl $(BUILD)/vbcl --size 16 --scenes a1,a6 --out $(BUILD)/gallery-quick \
-	  > $(BUILD)/gallery-quick.log 2>&1 && echo "gallery --size 16: ran (A.1, A.6)" \
-	  || { tail -30 $(BUILD)/gallery-quick.log; echo "gallery --size 16 FAILED"; exit 1; }
-	$(Q)scripts/bench.py --quick --vbcl $(BUILD)/vbcl --out $(BUILD)/bench-quick > $(BUILD)/bench-quick.log 2>&1 \
-	  && echo "bench --quick: every part ran ($(BUILD)/bench-quick/bench.md)" \
-	  || { tail -30 $(BUILD)/bench-quick.log; echo "bench --quick FAILED"; exit 1; }
-	$(Q)scripts/bench_rays_compare.py -n 1 --size 8 --repeats 1 $(BUILD)/vbcl-bench-rays \
-	  $(BUILD)/vbcl-bench-rays -- scenes/bench/spheres36.json > $(BUILD)/bench-rays-compare.log 2>&1 \
-	  && echo "bench_rays_compare.py: ran (spheres36, 8x8)" \
-	  || { tail -30 $(BUILD)/bench-rays-compare.log; echo "bench_rays_compare.py FAILED"; exit 1; }
+	$(Q)scripts/smoke.sh $(BUILD) > $(BUILD)/smoke.log 2>&1 & smoke=$$!; \
+	  $(BUILD)/vbcl-tests -j $(TEST_JOBS) --vbcl $(BUILD)/vbcl; tests=$$?; \
+	  wait $$smoke; smoked=$$?; cat $(BUILD)/smoke.log; [ $$tests = 0 ] && [ $$smoked = 0 ]
+else
+	$(Q)$(SAN_ENV) $(BUILD)/vbcl-tests -j $(TEST_JOBS) --vbcl $(BUILD)/vbcl
 endif
 
 # The thesis's appendix figures A.1 ... A.8 at their own settings (400x400), one at a time:
