@@ -15,7 +15,7 @@
 
 enum { TH_MAX_TESTS = 1024, TH_MAX_FAILED = 64, TH_NAME = 96, TH_MAX_GROUPS = 16 };
 
-/* What the workers share (an anonymous shared mapping): which tests are taken, the counts,
+/* What the workers share (a memfd mapped by each): which tests are taken, the counts,
  * the failed tests' names, what each worker runs, and the lock on the output. */
 typedef struct {
     int claimed[TH_MAX_TESTS];
