@@ -60,6 +60,20 @@ static void random_points(float *pts, int n, unsigned seed, float half)
     " \"objects\": [{\"shape\": \"quad\", \"size\": [2, 1], \"material\": \"img\","                \
     "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0.5, 0.5, 0]}}]}"
 
+/* Material mat's surface pattern at n points (xyz of each 4 floats) into out (rgb of each
+ * 4), through the probe kernel probe_pattern. */
+static void pattern_at(Fixture *fx, int mat, const float *pts, int n, float *out)
+{
+    size_t bytes = sizeof(float) * 4 * (size_t)n;
+    cl_mem mp = buffer(pts, bytes), mo = buffer(NULL, bytes);
+    const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
+    const void *v[] = {&mat, &mp, &n, &mo};
+    fixture_run_probe(fx, "probe_pattern", (size_t)n, 4, sz, v);
+    read_buffer(mo, out, bytes);
+    clReleaseMemObject(mp);
+    clReleaseMemObject(mo);
+}
+
 /* In the kernel, G (clamped at 0) matches the host's solidtex_fourier_eval at texture
  * coordinates (p - origin) / size; the projection returns each texel at its centre and 0
  * outside the unit square. */
@@ -72,12 +86,7 @@ static void test_patterns_probe_matches_host(void)
     enum { N = 64 };
     float pts[N * 4], out[N * 4];
     random_points(pts, N, 5, 3.0f);
-    cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
-    int n = N, mat = 1; /* "g" */
-    const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    const void *v[] = {&mat, &mp, &n, &mo};
-    fixture_run_probe(&fx, "probe_pattern", N, 4, sz, v);
-    read_buffer(mo, out, sizeof out);
+    pattern_at(&fx, 1, pts, N, out); /* "g" */
     VbFourier four;
     char err[256];
     const float freq[3] = {2, 3, 4};
@@ -106,13 +115,8 @@ static void test_patterns_probe_matches_host(void)
      * square's boundary is not speckled with zeros) */
     tp[40] = -1e-6f, tp[41] = 0.9f, tp[44] = 1.0f + 1e-6f, tp[45] = 0.1f;
     tp[48] = 0.1f, tp[49] = 1.0f + 1e-6f, tp[52] = 0.9f, tp[53] = -1e-6f;
-    cl_mem mt = buffer(tp, sizeof tp), mq = buffer(NULL, sizeof tp);
-    n = 14;
-    mat = 2; /* "img" */
-    const void *v2[] = {&mat, &mt, &n, &mq};
-    fixture_run_probe(&fx, "probe_pattern", 14, 4, sz, v2);
     float got[14 * 4];
-    read_buffer(mq, got, sizeof got);
+    pattern_at(&fx, 2, tp, 14, got); /* "img" */
     for (int t = 0; t < 8; t++)
         for (int c = 0; c < 3; c++)
             CHECK(got[4 * t + c] == image[t][c], "texel %d channel %d: %g, image %g", t, c,
@@ -122,10 +126,6 @@ static void test_patterns_probe_matches_host(void)
     for (int k = 0; k < 4; k++)
         CHECK(got[40 + 4 * k] == image[edge_texel[k]][0], "1e-6 beyond edge %d: texel %d (%g, %g)",
               k, edge_texel[k], got[40 + 4 * k], image[edge_texel[k]][0]);
-    clReleaseMemObject(mp);
-    clReleaseMemObject(mo);
-    clReleaseMemObject(mt);
-    clReleaseMemObject(mq);
     fixture_close(&fx);
 }
 
@@ -178,13 +178,8 @@ static void test_patterns_checker(void)
     enum { N = 256 };
     float pts[N * 4], out[N * 4];
     random_points(pts, N, 11, 4.0f);
-    cl_mem mp = buffer(pts, sizeof pts), mo = buffer(NULL, sizeof out);
-    const size_t sz[] = {sizeof(int), sizeof(cl_mem), sizeof(int), sizeof(cl_mem)};
-    int n = N;
     for (int mat = 3; mat <= 4; mat++) { /* "chk" (xz), "chk3" (xyz) */
-        const void *v[] = {&mat, &mp, &n, &mo};
-        fixture_run_probe(&fx, "probe_pattern", N, 4, sz, v);
-        read_buffer(mo, out, sizeof out);
+        pattern_at(&fx, mat, pts, N, out);
         int bad = 0, odd = 0;
         for (int i = 0; i < N; i++) {
             const float *p = pts + 4 * i;
@@ -203,8 +198,6 @@ static void test_patterns_checker(void)
         CHECK(odd > N / 4 && odd < 3 * N / 4, "material %d: both colours appear (%d odd)", mat,
               odd);
     }
-    clReleaseMemObject(mp);
-    clReleaseMemObject(mo);
     fixture_close(&fx);
 }
 
