@@ -24,6 +24,7 @@ typedef struct {
     int group_owner[TH_MAX_GROUPS];
     char failed_names[TH_MAX_FAILED][TH_NAME];
     char running[TH_MAX_JOBS][TH_NAME];
+    char output[TH_MAX_JOBS][64]; /* the file that holds the running test's output */
 } Shared;
 
 int th_checks_failed;
@@ -62,12 +63,20 @@ static void write_all(const char *buf, size_t n)
 }
 
 /* In a worker, sends fds 1 and 2 to a temporary file for one test (its output is shown
- * whole, after it ends); returns the file, or NULL where output goes straight out. */
+ * whole, after it ends, or by the parent if the worker dies in it: its name is in
+ * shared->output); returns the file, or NULL where output goes straight out. */
 static FILE *capture_begin(int saved[2])
 {
     if (!shared) return NULL;
-    FILE *f = tmpfile();
-    if (!f) return NULL;
+    char *path = shared->output[worker];
+    snprintf(path, sizeof shared->output[0], "/tmp/vbcl-tests-out-XXXXXX");
+    int fd = mkstemp(path);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "w+");
+    if (!f) {
+        if (fd >= 0) close(fd);
+        path[0] = 0;
+        return NULL;
+    }
     fflush(stdout);
     fflush(stderr);
     /* only fds 1 and 2 reach the test's own child processes (a test may set ulimit -n 4) */
@@ -94,6 +103,8 @@ static void capture_end(FILE *f, const int saved[2])
     size_t got = 0;
     if (buf && fseek(f, 0, SEEK_SET) == 0) got = fread(buf, 1, (size_t)n, f);
     fclose(f);
+    unlink(shared->output[worker]);
+    shared->output[worker][0] = 0;
     while (__atomic_exchange_n(&shared->out_lock, 1, __ATOMIC_ACQUIRE)) sched_yield();
     write_all(buf ? buf : "    (output lost: no memory)\n", buf ? got : 29);
     __atomic_store_n(&shared->out_lock, 0, __ATOMIC_RELEASE);
@@ -181,6 +192,14 @@ static void parent_wait(const pid_t *pids, int jobs)
         if (waitpid(pids[k], &st, 0) < 0) st = -1;
         if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
             broken++;
+            fflush(stdout);
+            if (shared->output[k][0]) { /* what the test printed before its worker died */
+                FILE *f = fopen(shared->output[k], "r");
+                char buf[4096];
+                for (size_t n; f && (n = fread(buf, 1, sizeof buf, f)) > 0;) write_all(buf, n);
+                if (f) fclose(f);
+                unlink(shared->output[k]);
+            }
             printf("FAIL worker %d ended (%s %d) while running %s\n", k,
                    st != -1 && WIFSIGNALED(st) ? "signal" : "status",
                    st == -1          ? -1
