@@ -23,8 +23,8 @@ typedef struct DevScene {
     }
 
 /* The colour a material's surface pattern gives at point p (1 without a pattern):
- * max(G, 0) for Fourier synthesis, the image's texel for an orthogonal projection (0
- * outside its unit square), at texture coordinates (p - origin) / size. */
+ * max(G, 0) for Fourier synthesis, the image's texel for an orthogonal projection along
+ * one axis (0 outside its unit square), at texture coordinates (p - origin) / size. */
 VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMaterial *m, float3 p)
 {
 #ifdef VBCL_HAS_PATTERNS
@@ -40,7 +40,9 @@ VB_INLINE float3 scene_pattern_colour(const DevScene *sc, __global const VbMater
                   ((pt->axes & 4u) ? cell.z : 0);
         return vb_gload3(pt->colours[sum & 1]);
     }
-    int t = solidtex_projection_texel(pt->width, pt->height, q.x, q.y);
+    /* a projection along axis k (bit k of axes): u, v the next two axes in cyclic order */
+    float2 uv = (pt->axes & 1u) ? q.yz : (pt->axes & 2u) ? q.zx : q.xy;
+    int t = solidtex_projection_texel(pt->width, pt->height, uv.x, uv.y);
     if (t < 0) return (float3)(0.0f);
     return vload3(0, sc->texels + 4 * ((size_t)pt->texel_offset + (size_t)t));
 #else

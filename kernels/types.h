@@ -22,7 +22,7 @@
 
 /* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
 #define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
-#define VBCL_PATTERN_PROJECTION 2 /* orthogonal projection of an image along Z */
+#define VBCL_PATTERN_PROJECTION 2 /* orthogonal projection of an image along one axis */
 #define VBCL_PATTERN_CHECKER    3 /* cells of two colours, constant along the axes not in axes */
 
 /* Volume textures: at most this many objects per scene carry one; the medium state keeps
@@ -155,7 +155,8 @@ typedef struct VbPattern {
     float inv_size[4];
     VbFourier fourier;   /* VBCL_PATTERN_FOURIER */
     float colours[2][4]; /* VBCL_PATTERN_CHECKER: the cell of (0, 0, 0) and its neighbours' */
-    unsigned int axes;   /* VBCL_PATTERN_CHECKER: bit k set: the cells alternate along axis k */
+    unsigned int axes;   /* CHECKER: bit k set: the cells alternate along axis k; PROJECTION:
+                          * the bit of the axis it projects along */
     unsigned int pad[3];
 } VbPattern;
 

@@ -10,6 +10,7 @@
 #include "fixture.h"
 #include "harness.h"
 #include "image_io.h"
+#include "scene.h"
 #include "texgen.h"
 #include "testutil.h"
 
@@ -52,11 +53,15 @@ static void random_points(float *pts, int n, unsigned seed, float half)
     "   \"g\": {\"pattern\": {\"type\": \"fourier\", \"terms\": 6, \"contrast\": 0.5,"             \
     "          \"frequency\": [2, 3, 4], \"seed\": 7, \"origin\": [1, 2, 3], \"size\": 2}},"       \
     "   \"img\": {\"diffuse\": [1, 1, 1], \"pattern\": {\"type\": \"projection\", \"image\": "     \
-    "\"%s\"}},"                                                                                    \
+    "\"%1$s\"}},"                                                                                  \
     "   \"chk\": {\"pattern\": {\"type\": \"checker\", \"size\": 0.5, \"origin\": [0.1, 0, 0.2],"  \
     "          \"colours\": [[1, 0, 0], [0, 0, 1]]}},"                                             \
     "   \"chk3\": {\"pattern\": {\"type\": \"checker\", \"size\": [0.5, 0.25, 2], \"axes\": "      \
-    "\"xyz\"}}},"                                                                                  \
+    "\"xyz\"}},"                                                                                   \
+    "   \"imgx\": {\"pattern\": {\"type\": \"projection\", \"image\": \"%1$s\", \"axis\": "        \
+    "\"x\"}},"                                                                                     \
+    "   \"imgy\": {\"pattern\": {\"type\": \"projection\", \"image\": \"%1$s\", \"axis\": "        \
+    "\"y\"}}},"                                                                                    \
     " \"objects\": [{\"shape\": \"quad\", \"size\": [2, 1], \"material\": \"img\","                \
     "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0.5, 0.5, 0]}}]}"
 
@@ -126,6 +131,24 @@ static void test_patterns_probe_matches_host(void)
     for (int k = 0; k < 4; k++)
         CHECK(got[40 + 4 * k] == image[edge_texel[k]][0], "1e-6 beyond edge %d: texel %d (%g, %g)",
               k, edge_texel[k], got[40 + 4 * k], image[edge_texel[k]][0]);
+    /* along x and y: the same texel centres, with (u, v) on (y, z) and (z, x), the projection
+     * axis's own coordinate anything */
+    for (int axis = 0; axis < 2; axis++) {
+        float ap[8 * 4];
+        for (int t = 0; t < 8; t++) {
+            float u = (t % 4 + 0.5f) / 4, v = 1 - (t / 4 + 0.5f) / 2, *q = ap + 4 * t;
+            q[axis] = 7.0f * (float)t - 20.0f;
+            q[(axis + 1) % 3] = u;
+            q[(axis + 2) % 3] = v;
+            q[3] = 0;
+        }
+        float ag[8 * 4];
+        pattern_at(&fx, 5 + axis, ap, 8, ag); /* "imgx", "imgy" */
+        for (int t = 0; t < 8; t++)
+            for (int c = 0; c < 3; c++)
+                CHECK(ag[4 * t + c] == image[t][c], "along %c, texel %d channel %d: %g, image %g",
+                      'x' + axis, t, c, ag[4 * t + c], image[t][c]);
+    }
     fixture_close(&fx);
 }
 
@@ -201,8 +224,41 @@ static void test_patterns_checker(void)
     fixture_close(&fx);
 }
 
+/* A pattern key on the wrong type, or a bad axis, is refused naming the key's JSON path. */
+static void test_patterns_bad_keys(void)
+{
+    static const char *const cases[][2] = {
+        {"{\"type\": \"projection\", \"image\": \"a.png\", \"axes\": \"xz\"}",
+         "materials.m.pattern.axes: only a checker pattern takes colours and axes"},
+        {"{\"type\": \"checker\", \"axis\": \"y\"}",
+         "materials.m.pattern.axis: only a projection pattern takes an axis"},
+        {"{\"type\": \"projection\", \"image\": \"a.png\", \"axis\": \"w\"}",
+         "materials.m.pattern.axis: expected the axis to project along"},
+        {"{\"type\": \"projection\", \"image\": \"a.png\", \"axis\": \"xy\"}",
+         "materials.m.pattern.axis: expected the axis to project along"},
+        {"{\"type\": \"checker\", \"axes\": \"xx\"}",
+         "materials.m.pattern.axes: expected the axes the cells alternate along"},
+        {"{\"type\": \"checker\", \"colours\": [[1, 0, 0]]}",
+         "materials.m.pattern.colours: expected two colours"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char json[1024], err[1024] = "";
+        snprintf(json, sizeof json,
+                 "{\"camera\": {\"eye\": [0, 0, 4], \"look_at\": [0, 0, 0]}, \"materials\": "
+                 "{\"m\": {\"pattern\": %s}}, \"objects\": [{\"shape\": \"sphere\", "
+                 "\"material\": \"m\"}]}",
+                 cases[i][0]);
+        Scene sc;
+        int rc = scene_load_text("p.json", json, -1, &sc, err, sizeof err);
+        if (!rc) scene_free(&sc);
+        CHECK(rc != 0 && strstr(err, cases[i][1]), "%s: expected \"%s\", got (%d) \"%s\"",
+              cases[i][0], cases[i][1], rc, err);
+    }
+}
+
 void suite_patterns(void)
 {
+    RUN_TEST(test_patterns_bad_keys);
     RUN_PROBE_TEST(test_patterns_probe_matches_host);
     RUN_TEST(test_patterns_render_projection);
     RUN_PROBE_TEST(test_patterns_checker);

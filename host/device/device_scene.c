@@ -202,6 +202,7 @@ static int pattern_make(const Scene *s, int i, VbPattern *pt, Texels *tx, char *
     const ScenePattern *sp = &s->materials[i].pattern;
     char perr[512];
     pt->kind = sp->kind;
+    pt->axes = sp->axes; /* a checker's axes, a projection's axis */
     for (int k = 0; k < 3; k++) {
         pt->origin[k] = sp->origin[k];
         pt->inv_size[k] = 1.0f / sp->size[k];
@@ -209,7 +210,6 @@ static int pattern_make(const Scene *s, int i, VbPattern *pt, Texels *tx, char *
     if (sp->kind == VBCL_PATTERN_CHECKER) {
         for (int c = 0; c < 2; c++)
             for (int k = 0; k < 3; k++) pt->colours[c][k] = sp->colours[c][k];
-        pt->axes = sp->axes;
         return 0;
     }
     if (sp->kind == VBCL_PATTERN_FOURIER) {

@@ -54,10 +54,29 @@ static int load_checker(Ctx *c, const cJSON *j, const char *p, ScenePattern *pt)
     return 0;
 }
 
+/* A projection's "axis" ("x", "y" or "z", the default): the image lies across the other two
+ * in cyclic order, u along the first and v along the second (x: y, z; y: z, x; z: x, y), and
+ * is projected along it; kept in pt->axes as that axis's bit. Refused on other patterns. */
+static int load_projection_axis(Ctx *c, const cJSON *j, const char *p, ScenePattern *pt)
+{
+    const cJSON *ax = cJSON_GetObjectItemCaseSensitive(j, "axis");
+    char q[PATH_MAX_LEN];
+    json_path_key(q, p, "axis");
+    if (pt->kind != VBCL_PATTERN_PROJECTION)
+        return ax ? scene_fail(c, q, "only a projection pattern takes an axis") : 0;
+    pt->axes = 4u;
+    if (!ax) return 0;
+    const char *a = cJSON_IsString(ax) ? ax->valuestring : "";
+    if (strlen(a) != 1 || !strchr("xyz", a[0]))
+        return scene_fail(c, q, "expected the axis to project along: \"x\", \"y\" or \"z\"");
+    pt->axes = 1u << (a[0] - 'x');
+    return 0;
+}
+
 static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s, ScenePattern *pt)
 {
     static const char *const keys[] = {"type",   "terms", "contrast", "frequency", "seed", "image",
-                                       "origin", "size",  "colours",  "axes",      NULL};
+                                       "origin", "size",  "colours",  "axes",      "axis", NULL};
     static const float zero[3] = {0, 0, 0};
     const cJSON *j = cJSON_GetObjectItemCaseSensitive(e, "pattern");
     if (!j) return 0;
@@ -103,7 +122,7 @@ static int load_pattern(Ctx *c, const cJSON *e, const char *path, const Scene *s
     } else if (img) {
         return scene_fail(c, q, "only a projection pattern takes an image");
     }
-    return 0;
+    return load_projection_axis(c, j, p, pt);
 }
 
 /* The first wavelength where the model's index is not a finite number > 0, or 0: every
