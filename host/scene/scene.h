@@ -21,7 +21,7 @@
 typedef struct ScenePattern {
     int kind;            /* 0 none, VBCL_PATTERN_FOURIER, _PROJECTION or _CHECKER */
     float colours[2][3]; /* checker: the two colours */
-    unsigned axes;       /* checker: bit k, the cells alternate along axis k; projection: its axis */
+    unsigned axes;       /* checker: bit k, cells alternate along axis k; projection: its axis */
     int terms;
     float contrast, freq[3];
     unsigned long long seed;
