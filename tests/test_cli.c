@@ -44,13 +44,8 @@ static int vbcl(const char *args, char *out, size_t n)
 /* The file at path parsed as JSON, or NULL. */
 static cJSON *read_json(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
     static char text[1 << 16];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[n] = 0;
-    return cJSON_Parse(text);
+    return cJSON_Parse(tu_read_file(path, text, sizeof text)); /* "" (no file): NULL */
 }
 
 /* The number at a path of object keys (NULL-terminated), or NAN where one is missing. */
@@ -508,14 +503,9 @@ static void expect_bad(const char *scene_text, const char *extra_args, const cha
     CHECK(strstr(out, needle) != NULL, "message \"%s\" names \"%s\"", out, needle);
     char *nl = strchr(out, '\n');
     CHECK(nl && nl[1] == 0, "exactly one line: %s", out);
-    char buf[64] = "";
-    f = fopen(img, "r");
-    if (f) {
-        size_t n = fread(buf, 1, sizeof buf - 1, f);
-        buf[n] = 0;
-        fclose(f);
-    }
-    CHECK(strcmp(buf, "previous image") == 0, "existing output untouched");
+    char buf[64];
+    CHECK(strcmp(tu_read_file(img, buf, sizeof buf), "previous image") == 0,
+          "existing output untouched");
 }
 
 /* --frames renders numbered frames of an animated scene: a run of # in -o becomes the frame

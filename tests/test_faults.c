@@ -37,13 +37,8 @@ static void put_old(const char *path)
 /* Whether path still holds OLD_TEXT, whole. */
 static int old_intact(const char *path)
 {
-    char buf[256] = "";
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = 0;
-    return strcmp(buf, OLD_TEXT) == 0;
+    char buf[256];
+    return strcmp(tu_read_file(path, buf, sizeof buf), OLD_TEXT) == 0;
 }
 
 /* A directory of its own under the test directory (made empty). */
@@ -390,11 +385,8 @@ static void test_faults_unbounded_tree(void)
     int rc = tu_run(cmd, out, sizeof out);
     CHECK(rc == 0 && strstr(out, "ray-tree branches were not traced"),
           "depth 64 unpruned between two slabs: finishes and warns (%d): %s", rc, out);
-    char text[1 << 16] = "";
-    FILE *f = fopen(json, "rb");
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    if (f) fclose(f);
-    text[n] = 0;
+    static char text[1 << 16];
+    tu_read_file(json, text, sizeof text);
     const char *cut = strstr(text, "\"tree_cut\":");
     CHECK(cut && atof(cut + strlen("\"tree_cut\":")) > 0, "ray_tree.tree_cut counted: %.80s",
           cut ? cut : text);

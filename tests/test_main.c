@@ -52,6 +52,15 @@ int tu_run(const char *cmd, char *out, size_t outlen)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
 }
 
+char *tu_read_file(const char *path, char *buf, size_t n)
+{
+    FILE *f = fopen(path, "rb");
+    size_t got = f && n > 0 ? fread(buf, 1, n - 1, f) : 0;
+    if (f) fclose(f);
+    if (n > 0) buf[got] = 0;
+    return buf;
+}
+
 int tu_dir_has(const char *dir, const char *part)
 {
     DIR *d = opendir(dir);

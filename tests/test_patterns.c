@@ -65,6 +65,14 @@ static void random_points(float *pts, int n, unsigned seed, float half)
     " \"objects\": [{\"shape\": \"quad\", \"size\": [2, 1], \"material\": \"img\","                \
     "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0.5, 0.5, 0]}}]}"
 
+/* PATTERN_SCENE prepared on the test device (fixture_open's result). */
+static int open_pattern_scene(Fixture *fx)
+{
+    char json[4096];
+    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
+    return fixture_open(fx, json);
+}
+
 /* Material mat's surface pattern at n points (xyz of each 4 floats) into out (rgb of each
  * 4), through the probe kernel probe_pattern. */
 static void pattern_at(Fixture *fx, int mat, const float *pts, int n, float *out)
@@ -84,10 +92,8 @@ static void pattern_at(Fixture *fx, int mat, const float *pts, int n, float *out
  * outside the unit square. */
 static void test_patterns_probe_matches_host(void)
 {
-    char json[4096];
-    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
     Fixture fx;
-    if (fixture_open(&fx, json)) return;
+    if (open_pattern_scene(&fx)) return;
     enum { N = 64 };
     float pts[N * 4], out[N * 4];
     random_points(pts, N, 5, 3.0f);
@@ -194,10 +200,8 @@ static void test_patterns_render_projection(void)
  * ("xyz"); the default colours are 0.9 and 0.15 grey. */
 static void test_patterns_checker(void)
 {
-    char json[4096];
-    snprintf(json, sizeof json, PATTERN_SCENE, write_image());
     Fixture fx;
-    if (fixture_open(&fx, json)) return;
+    if (open_pattern_scene(&fx)) return;
     enum { N = 256 };
     float pts[N * 4], out[N * 4];
     random_points(pts, N, 11, 4.0f);

@@ -106,12 +106,8 @@ static double json_num(const cJSON *o, const char *key)
 /* Reads a --stats-json document (caller frees), or NULL after a failed check. */
 static cJSON *read_json(const char *path)
 {
-    FILE *f = fopen(path, "rb");
     static char text[1 << 20];
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    if (f) fclose(f);
-    text[n] = 0;
-    cJSON *doc = cJSON_Parse(text);
+    cJSON *doc = cJSON_Parse(tu_read_file(path, text, sizeof text));
     CHECK(doc != NULL, "%s does not parse", path);
     return doc;
 }

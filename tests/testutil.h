@@ -23,6 +23,10 @@ const char *tu_tmpdir(void);
 /* Writes text to dir/name and returns the full path in a static buffer ring. */
 const char *tu_write_file(const char *name, const char *text);
 
+/* Reads up to n - 1 bytes of the file at path into buf, NUL-terminated (empty when it
+ * cannot be opened); returns buf. */
+char *tu_read_file(const char *path, char *buf, size_t n);
+
 /* Whether directory dir holds a file whose name contains part. */
 int tu_dir_has(const char *dir, const char *part);
 

@@ -12,10 +12,12 @@ int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats 
                size_t errlen)
 {
     memset(fr, 0, sizeof *fr);
+    char host[sizeof fr->work[0].host] = "";
+    if (gethostname(host, sizeof host - 1)) host[0] = 0;
     for (int i = 0; i < ndev && i < CLU_MAX_DEVICES; i++) {
         snprintf(fr->work[i].name, sizeof fr->work[i].name, "%s", devs[i].name);
         fr->work[i].index = devs[i].index;
-        if (gethostname(fr->work[i].host, sizeof fr->work[i].host - 1)) fr->work[i].host[0] = 0;
+        memcpy(fr->work[i].host, host, sizeof host);
     }
     int rc = renderer_init(&fr->r, &devs[0], s, NULL, st, err, errlen);
     if (rc || ndev < 2) return rc;
