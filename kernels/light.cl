@@ -613,7 +613,8 @@ VB_INLINE int light_cap_closed_form(const DevScene *scn, const ShadePoint *sp,
 {
     if (!ls->diffuse || !lobe_off) return 0;
 #ifdef VBCL_HAS_ABSORPTION
-    if (vb_max3(vb_gload3(scn->materials[medium_material(scn, sp->medium)].extinction)) != 0.0f)
+    if ((scn->f->flags & VBCL_FRAME_ABSORPTION) &&
+        vb_max3(vb_gload3(scn->materials[medium_material(scn, sp->medium)].extinction)) != 0.0f)
         return 0;
 #else
     (void)scn;

@@ -56,10 +56,12 @@ VB_INLINE Crossing medium_cross(const DevScene *sc, int tri, float3 dir, VbMediu
     return c;
 }
 
-/* Beer–Lambert attenuation exp(-alpha d) over a distance d inside material mat. */
+/* Beer–Lambert attenuation exp(-alpha d) over a distance d inside material mat (1 without
+ * a load when no material of the scene absorbs). */
 VB_INLINE float3 medium_absorb(const DevScene *sc, uint mat, float d)
 {
 #ifdef VBCL_HAS_ABSORPTION
+    if (!(sc->f->flags & VBCL_FRAME_ABSORPTION)) return (float3)(1.0f);
     float3 a = vb_gload3(sc->materials[mat].extinction);
     return select(exp(-a * d), (float3)(1.0f), isequal(a, (float3)(0.0f)));
 #else

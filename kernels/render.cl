@@ -126,6 +126,16 @@ __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
     rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)pixel);
 }
 
+/* This work group's copy of the counters (VBCL_COUNTER_SLOTS in types.h). */
+#define COUNTER_SLOT(counters)                                                                     \
+    ((counters) + get_group_id(0) % VBCL_COUNTER_SLOTS * VBCL_COUNTER_STRIDE)
+
+/* counters[k] += v: one atomic add, none when v is 0 (as most of a work item's counts are). */
+VB_INLINE void counter_add(__global uint *counters, int k, uint v)
+{
+    if (v) atomic_add(&counters[k], v);
+}
+
 /* rays -> hits, media: the closest interface of each camera ray (camera_trace_closest: its
  * image tile's triangles, or the grid), and the medium the ray is in just before it (rays
  * start in the camera's medium). */
@@ -148,26 +158,27 @@ __kernel void scene_intersect_closest(FRAME_KERNEL_ARGS)
                       ? ph.hit
                       : miss;
         media[i] = state;
-        if (passes) atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], passes);
+        counter_add(COUNTER_SLOT(counters), VBCL_COUNT_PASS_THROUGH, passes);
     } else
 #endif
         hits[i] = camera_trace_closest(&sc, vb_load3(r.org), vb_load3(r.dir), r.tmax, &tc);
-    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc.steps);
-    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc.tests);
+    counter_add(COUNTER_SLOT(counters), VBCL_COUNT_TRAVERSAL_STEPS, tc.steps);
+    counter_add(COUNTER_SLOT(counters), VBCL_COUNT_TRI_TESTS, tc.tests);
 }
 
-/* Adds one work item's shading counts (its feelers and their walks) to the frame counters. */
+/* Adds one work item's shading counts (its feelers and their walks) to its group's copy of
+ * the frame counters (COUNTER_SLOT). */
 VB_INLINE void shade_flush_counts(__global uint *counters, const TraceCount *tc,
                                   const ShadowCount *shc)
 {
-    atomic_add(&counters[VBCL_COUNT_SHADOW], shc->traced);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_SKIPPED], shc->skipped);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_UNNEEDED], shc->unneeded);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_CLEAR], shc->clear);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_BLOCKED], shc->blocked);
-    atomic_add(&counters[VBCL_COUNT_SHADOW_PENUMBRA], shc->penumbra);
-    atomic_add(&counters[VBCL_COUNT_TRAVERSAL_STEPS], tc->steps);
-    atomic_add(&counters[VBCL_COUNT_TRI_TESTS], tc->tests);
+    counter_add(counters, VBCL_COUNT_SHADOW, shc->traced);
+    counter_add(counters, VBCL_COUNT_SHADOW_SKIPPED, shc->skipped);
+    counter_add(counters, VBCL_COUNT_SHADOW_UNNEEDED, shc->unneeded);
+    counter_add(counters, VBCL_COUNT_SHADOW_CLEAR, shc->clear);
+    counter_add(counters, VBCL_COUNT_SHADOW_BLOCKED, shc->blocked);
+    counter_add(counters, VBCL_COUNT_SHADOW_PENUMBRA, shc->penumbra);
+    counter_add(counters, VBCL_COUNT_TRAVERSAL_STEPS, tc->steps);
+    counter_add(counters, VBCL_COUNT_TRI_TESTS, tc->tests);
 }
 
 /* rays, hits, media -> radiance (rgb + 1 per ray): the k_local term at each primary hit
@@ -206,7 +217,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
         TraceCount tc = {0, 0};
         ShadowCount shc = {0, 0, 0, 0, 0, 0};
         col = weight * light_shade_local(&sc, &sp, f->shadow_strata, &tc, &shc);
-        shade_flush_counts(counters, &tc, &shc);
+        shade_flush_counts(COUNTER_SLOT(counters), &tc, &shc);
     }
     vstore4((float4)(col, 1.0f), i, radiance);
 }
@@ -253,25 +264,25 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share
     return acc;
 }
 
-/* Adds one work item's tree counts to the frame counters. */
+/* Adds one work item's tree counts to its group's copy of the frame counters. */
 VB_INLINE void tree_flush_counts(__global uint *counters, const TreeCount *cnt,
                                  const TraceCount *tc, const ShadowCount *shc)
 {
-    atomic_add(&counters[VBCL_COUNT_REFLECTED], cnt->reflected);
-    atomic_add(&counters[VBCL_COUNT_TRANSMITTED], cnt->transmitted);
-    atomic_add(&counters[VBCL_COUNT_PRUNED], cnt->pruned);
-    atomic_add(&counters[VBCL_COUNT_DEPTH_CUT], cnt->depth_cut);
-    atomic_add(&counters[VBCL_COUNT_TIR], cnt->tir);
-    atomic_add(&counters[VBCL_COUNT_PASS_THROUGH], cnt->passes);
-    atomic_add(&counters[VBCL_COUNT_INTERFACES], cnt->interfaces);
-    atomic_add(&counters[VBCL_COUNT_ENERGY_ERRORS], cnt->energy_errors);
-    if (cnt->tree_cut) atomic_add(&counters[VBCL_COUNT_TREE_CUT], cnt->tree_cut);
+    counter_add(counters, VBCL_COUNT_REFLECTED, cnt->reflected);
+    counter_add(counters, VBCL_COUNT_TRANSMITTED, cnt->transmitted);
+    counter_add(counters, VBCL_COUNT_PRUNED, cnt->pruned);
+    counter_add(counters, VBCL_COUNT_DEPTH_CUT, cnt->depth_cut);
+    counter_add(counters, VBCL_COUNT_TIR, cnt->tir);
+    counter_add(counters, VBCL_COUNT_PASS_THROUGH, cnt->passes);
+    counter_add(counters, VBCL_COUNT_INTERFACES, cnt->interfaces);
+    counter_add(counters, VBCL_COUNT_ENERGY_ERRORS, cnt->energy_errors);
+    counter_add(counters, VBCL_COUNT_TREE_CUT, cnt->tree_cut);
 #ifdef VBCL_HAS_DISPERSION
-    if (cnt->splits) atomic_add(&counters[VBCL_COUNT_SPLITS], cnt->splits);
-    if (cnt->band_rays) atomic_add(&counters[VBCL_COUNT_BAND_RAYS], cnt->band_rays);
+    counter_add(counters, VBCL_COUNT_SPLITS, cnt->splits);
+    counter_add(counters, VBCL_COUNT_BAND_RAYS, cnt->band_rays);
 #endif
     for (int d = 1; d < VBCL_COUNT_DEPTH_BINS; d++)
-        if (cnt->by_depth[d]) atomic_add(&counters[VBCL_COUNT_DEPTH0 + d], cnt->by_depth[d]);
+        counter_add(counters, VBCL_COUNT_DEPTH0 + d, cnt->by_depth[d]);
     shade_flush_counts(counters, tc, shc);
 }
 
@@ -315,7 +326,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
 #ifdef VBCL_HAS_DISPERSION
     if (rec) rec->budget = cnt.prune_budget;
 #endif
-    tree_flush_counts(counters, &cnt, &tc, &shc);
+    tree_flush_counts(COUNTER_SLOT(counters), &cnt, &tc, &shc);
 }
 
 #ifdef VBCL_HAS_DISPERSION
@@ -355,7 +366,7 @@ __kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
         acc += tree_run(&sc, stack, n, share, &cnt, &tc, &shc, 0);
     }
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
-    tree_flush_counts(counters, &cnt, &tc, &shc);
+    tree_flush_counts(COUNTER_SLOT(counters), &cnt, &tc, &shc);
 }
 #endif
 #endif

@@ -55,7 +55,8 @@
         * VbObject.plane holds a sphere inside it (its core), and a feeler from outside its        \
         * bounds that passes through the core is stopped by it, whatever it meets on the way */
 
-/* The work counters the kernels keep (one atomic add per work item, not per ray): one list,
+/* The work counters the kernels keep (at most one atomic add per work item, not per ray, into
+ * its work group's copy: VBCL_COUNTER_SLOTS): one list,
  * X(NAME, index, RenderStats field, stats group, key), from which come the indices
  * VBCL_COUNT_NAME into the counters buffer, the RenderStats fields (host/device/render.h), their
  * accumulation after each batch (renderer_trace_rays) and their place in --stats-json: the
@@ -88,6 +89,13 @@ enum { VBCL_COUNT_PRIMARY = 0, VBCL_COUNTER_LIST(VBCL_COUNTER_INDEX) };
 #define VBCL_COUNT_DEPTH0     20 /* rays traced at depth d: counter DEPTH0 + min(d, 15) */
 #define VBCL_COUNT_DEPTH_BINS 16
 #define VBCL_COUNTERS         36
+/* The counters buffer holds VBCL_COUNTER_SLOTS copies of the counters, VBCL_COUNTER_STRIDE
+ * words (a multiple of 64 bytes) apart: work group g adds into copy g % VBCL_COUNTER_SLOTS,
+ * so that groups running at once on different cores seldom add to the same cache line,
+ * and the host sums the copies once per batch (renderer_trace_rays). */
+#define VBCL_COUNTER_SLOTS  16
+#define VBCL_COUNTER_STRIDE 48
+#define VBCL_COUNTER_WORDS  (VBCL_COUNTER_SLOTS * VBCL_COUNTER_STRIDE)
 /* The most rays one sample's ray tree traces (tree_run): a tree that reaches it leaves its
  * pending branches untraced, counted as tree_cut. Deep trees without pruning between
  * several dielectrics can hold 2^max_depth rays; every example scene's trees stay far
@@ -352,12 +360,13 @@ typedef struct VbFrame {
          * level, and its points count 2^-level of their weight (sample_share) */
 /* What the scene uses, for programs compiled with more than it needs (kernel_features.c):
  * each of these is tested at run time wherever the program has the code for it. */
-#define VBCL_FRAME_FRESNEL_THESIS  32u  /* the thesis's angle-independent split (eq. 9) */
-#define VBCL_FRAME_SMOOTH_NORMALS  64u  /* the mesh has vertex normals (the normals buffer) */
-#define VBCL_FRAME_TRANSPARENCY    128u /* some surface has k_global > 0: rays cross media */
-#define VBCL_FRAME_TEXTURES        256u /* some object holds a volume texture */
-#define VBCL_FRAME_DISPERSION      512u /* some transparent material disperses: split records */
-#define VBCL_CONE_TEST_MAX_OBJECTS 64   /* scenes with more objects trace every feeler */
+#define VBCL_FRAME_FRESNEL_THESIS  32u   /* the thesis's angle-independent split (eq. 9) */
+#define VBCL_FRAME_SMOOTH_NORMALS  64u   /* the mesh has vertex normals (the normals buffer) */
+#define VBCL_FRAME_TRANSPARENCY    128u  /* some surface has k_global > 0: rays cross media */
+#define VBCL_FRAME_TEXTURES        256u  /* some object holds a volume texture */
+#define VBCL_FRAME_DISPERSION      512u  /* some transparent material disperses: split records */
+#define VBCL_FRAME_ABSORPTION      1024u /* some transparent material has an extinction > 0 */
+#define VBCL_CONE_TEST_MAX_OBJECTS 64    /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
 
@@ -493,6 +502,8 @@ VBCL_STATIC_ASSERT(((0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_OR)) & 1u) == 0 &&
                        (0u VBCL_COUNTER_LIST(VBCL_COUNTER_BIT_OR)) < (1u << VBCL_COUNT_DEPTH0),
                    counters_in_range);
 VBCL_STATIC_ASSERT(VBCL_COUNT_DEPTH0 + VBCL_COUNT_DEPTH_BINS <= VBCL_COUNTERS, counters_depth);
+VBCL_STATIC_ASSERT(VBCL_COUNTERS <= VBCL_COUNTER_STRIDE && VBCL_COUNTER_STRIDE % 16 == 0,
+                   counter_slots_apart);
 
 /* The scene's buffers, the one list behind every place that names them: the arguments
  * every frame kernel and scene probe starts with, in this order (render.cl

@@ -23,7 +23,7 @@ static void trace_grid_and_brute(Fixture *fx, const VbRay *rays, int n, VbHit *h
 {
     cl_mem mr = buffer(rays, sizeof *rays * (size_t)n);
     cl_mem mg = buffer(NULL, sizeof *hg * (size_t)n), mb = buffer(NULL, sizeof *hb * (size_t)n);
-    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_uint zero[VBCL_COUNTER_WORDS] = {0};
     cl_mem mc = buffer(zero, sizeof zero);
     trace_grid(fx, mr, n, mg, mc);
     cl_uint ntris = fx->s.mesh.ntris;
@@ -1131,7 +1131,7 @@ static void test_rays_at_edges_and_vertices_hit(void)
     }
     n = k;
     cl_mem mr = buffer(rays, sizeof *rays * (size_t)n), mh = buffer(NULL, sizeof *hits * (size_t)n);
-    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_uint zero[VBCL_COUNTER_WORDS] = {0};
     cl_mem mc = buffer(zero, sizeof zero);
     trace_grid(&fx, mr, n, mh, mc);
     read_buffer(mh, hits, sizeof *hits * (size_t)n);

@@ -206,7 +206,7 @@ static int tracer_open(Tracer *tr, VbDevice *d, const Scene *s, char *err, size_
                               NULL, &rc3);
     tr->hits = clCreateBuffer(d->context, CL_MEM_WRITE_ONLY,
                               sizeof(VbHit) * 2 * WT_AIMED * WT_BATCH, NULL, &rc4);
-    cl_uint zero[VBCL_COUNTERS] = {0};
+    cl_uint zero[VBCL_COUNTER_WORDS] = {0};
     tr->counters = clCreateBuffer(d->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero,
                                   zero, &rc5);
     cl_int rc6, rc7;

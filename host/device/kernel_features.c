@@ -136,7 +136,8 @@ unsigned features_frame_flags(unsigned f)
            ((f & VBCL_FEATURE_SMOOTH_NORMALS) ? VBCL_FRAME_SMOOTH_NORMALS : 0u) |
            ((f & VBCL_FEATURE_TRANSPARENCY) ? VBCL_FRAME_TRANSPARENCY : 0u) |
            ((f & VBCL_FEATURE_TEXTURES) ? VBCL_FRAME_TEXTURES : 0u) |
-           ((f & VBCL_FEATURE_DISPERSION) ? VBCL_FRAME_DISPERSION : 0u);
+           ((f & VBCL_FEATURE_DISPERSION) ? VBCL_FRAME_DISPERSION : 0u) |
+           ((f & VBCL_FEATURE_ABSORPTION) ? VBCL_FRAME_ABSORPTION : 0u);
 }
 
 /* "-cl-std=CL1.2", the tree stack when the program has transparency, and a -D for each of

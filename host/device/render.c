@@ -212,7 +212,7 @@ static int renderer_alloc_rays(Renderer *r, const Scene *s)
     r->hits = clu_buffer(dev, NULL, sizeof(VbHit) * (size_t)cap, CL_MEM_READ_WRITE);
     r->radiance = clu_buffer(dev, NULL, sizeof(float) * 4 * (size_t)cap, CL_MEM_READ_WRITE);
     r->media = clu_buffer(dev, NULL, sizeof(VbMedium) * (size_t)cap, CL_MEM_READ_WRITE);
-    r->counters = clu_buffer(dev, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
+    r->counters = clu_buffer(dev, NULL, sizeof(cl_uint) * VBCL_COUNTER_WORDS, CL_MEM_READ_WRITE);
     if (!r->rays || !r->hits || !r->radiance || !r->media || !r->counters) return 1;
     /* a program with dispersion takes the split records whether the scene disperses or not;
      * only a dispersive scene writes them */
@@ -254,12 +254,12 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
 {
     VbDevice *d = r->dev;
     cl_event ev[4] = {0};
-    cl_uint zero[VBCL_COUNTERS] = {0}, counts[VBCL_COUNTERS];
+    cl_uint zero = 0, slots[VBCL_COUNTER_WORDS], counts[VBCL_COUNTERS] = {0};
     size_t global = ((size_t)n + 63) / 64 * 64;
     int rc = -1;
-    CL_CHECK(
-        clEnqueueWriteBuffer(d->queue, r->counters, CL_FALSE, 0, sizeof zero, zero, 0, NULL, NULL),
-        done);
+    CL_CHECK(clEnqueueFillBuffer(d->queue, r->counters, &zero, sizeof zero, 0, sizeof slots, 0,
+                                 NULL, NULL),
+             done);
     /* first interfaces, local shading, with dielectrics the ray trees, and with dispersion
      * the dispersive subtrees the trees left in r->splits */
     cl_kernel stages[4] = {r->k_intersect, r->k_shading, r->k_tree, r->k_bands};
@@ -275,9 +275,11 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
                                         renderer_local(r, global), 0, NULL, &ev[k]),
                  done);
     }
-    CL_CHECK(clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof counts, counts, 0, NULL,
-                                 NULL),
-             done);
+    CL_CHECK(
+        clEnqueueReadBuffer(d->queue, r->counters, CL_TRUE, 0, sizeof slots, slots, 0, NULL, NULL),
+        done);
+    for (int g = 0; g < VBCL_COUNTER_SLOTS; g++) /* the work groups' copies */
+        for (int k = 0; k < VBCL_COUNTERS; k++) counts[k] += slots[g * VBCL_COUNTER_STRIDE + k];
     double ms[4];
     for (int k = 0; k < 4; k++) ms[k] = ev[k] ? clu_event_ms(ev[k]) : 0.0;
     st->intersect_ms += ms[0];

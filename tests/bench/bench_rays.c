@@ -237,7 +237,7 @@ static int trace_primary(Bench *b)
     b->hits = clu_buffer(d, NULL, sizeof(VbHit) * b->npix, CL_MEM_READ_WRITE);
     b->media = clu_buffer(d, NULL, sizeof(VbMedium) * b->npix, CL_MEM_READ_WRITE);
     cl_mem radiance = clu_buffer(d, NULL, sizeof(float) * 4 * b->npix, CL_MEM_READ_WRITE);
-    cl_mem counters = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_COUNTERS, CL_MEM_READ_WRITE);
+    cl_mem counters = clu_buffer(d, NULL, sizeof(cl_uint) * VBCL_COUNTER_WORDS, CL_MEM_READ_WRITE);
     b->h_rays = malloc(sizeof(VbRay) * b->npix);
     int rc = -1;
     if (!b->rays || !b->hits || !b->media || !radiance || !counters || !b->h_rays) goto done;
