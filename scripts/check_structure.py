@@ -30,16 +30,15 @@ def module_of(path, root):
     return os.path.splitext(os.path.relpath(path, root))[0]
 
 
-def include_graph(root):
-    """module -> set of modules whose headers it includes (resolved beside the includer,
-    then anywhere under host/ by file name, as the Makefile's -I flags do)."""
+def includes(root):
+    """(including file, header as written, header's path) for each include of a header of
+    host/, resolved beside the includer, then anywhere under host/ by file name, as the
+    Makefile's -I flags do."""
     files = list(sources(root, "host", (".c", ".h", ".cpp")))
     by_name = {}
     for f in files:
         by_name.setdefault(os.path.basename(f), []).append(f)
-    graph = {}
     for f in files:
-        mod = module_of(f, root)
         with open(f, encoding="utf-8") as fh:
             text = fh.read()
         for inc in INCLUDE.findall(text):
@@ -49,9 +48,16 @@ def include_graph(root):
                 target = by_name[os.path.basename(inc)][0]
             if target is None or not target.startswith(os.path.join(root, "host")):
                 continue  # kernels/types.h and system headers are below every module
-            dep = module_of(target, root)
-            if dep != mod:
-                graph.setdefault(mod, set()).add(dep)
+            yield f, inc, target
+
+
+def include_graph(root):
+    """module -> set of modules whose headers it includes (includes())."""
+    graph = {}
+    for f, _, target in includes(root):
+        mod, dep = module_of(f, root), module_of(target, root)
+        if dep != mod:
+            graph.setdefault(mod, set()).add(dep)
     return graph
 
 
