@@ -6,7 +6,13 @@
    named by its path without the extension, both files present) include each other's
    headers, in one folder or across. A folder may have a header of its own that several of
    its files implement (host/scene/scene.h): that is one component, not a cycle.
-2. No function in host/ or kernels/ is longer than 80 lines, unless the comment above it
+2. The table under "### The host's layers" of docs/architecture.md (columns folder, what,
+   uses) is the rule for which folders a folder uses: a file of a folder of host/ includes
+   headers only of its own folder and of those its row lists under "uses" (folder names
+   without host/, words in parentheses aside; "everything below": every folder of the rows
+   below). Headers of kernels/ and system headers go anywhere. A folder of host/ with
+   sources and no row, a row with no such folder, or no table at all is a violation too.
+3. No function in host/ or kernels/ is longer than 80 lines, unless the comment above it
    says why, in a line starting with "Long:".
 
 Prints each violation and exits 1 when there is one. usage: scripts/check_structure.py [ROOT]
@@ -139,6 +145,83 @@ def folder_graph(graph):
     return out
 
 
+DOC = os.path.join("docs", "architecture.md")
+LAYERS = "### The host's layers"
+
+
+def uses_of(cell):
+    """The folder names of a "uses" cell: backquotes, trailing slashes and words in
+    parentheses dropped, "—" for none."""
+    cell = re.sub(r"\([^)]*\)", "", cell).replace("`", "")
+    names = [n.strip().rstrip("/") for n in cell.split(",")]
+    return [n for n in names if n not in ("", "—", "-")]
+
+
+def layer_table(root):
+    """(rules, problems): rules maps each folder of the table under LAYERS in DOC ("| folder
+    | what | uses |") to the folders it may include headers from, itself among them; None
+    when there is no such table. A use names a folder without host/; "everything below" is
+    every folder of the rows below."""
+    try:
+        with open(os.path.join(root, DOC), encoding="utf-8") as fh:
+            lines = [line.rstrip() for line in fh.read().split("\n")]
+    except OSError as e:
+        return None, [f"{DOC}: cannot read it ({e.strerror}); its table of the host's layers "
+                      "is the rule"]
+    rows = []
+    for line in lines[lines.index(LAYERS) + 1:] if LAYERS in lines else []:
+        if line.startswith("#") or (rows and not line.startswith("|")):
+            break
+        if line.startswith("|"):
+            rows.append([c.strip() for c in line.strip().strip("|").split("|")])
+    head = [c.lower() for c in rows[0]] if rows else []
+    if "folder" not in head or "uses" not in head:
+        return None, [f'{DOC}: no table "| folder | what | uses |" under "{LAYERS}"']
+    problems, folders, uses = [], [], []
+    for row in rows[2:]:
+        if len(row) != len(head):
+            problems.append(f"{DOC}: a row of the host's layers with {len(row)} cells, not "
+                            f"{len(head)}: | {' | '.join(row)} |")
+            continue
+        folders.append(row[head.index("folder")].replace("`", "").rstrip("/"))
+        uses.append(uses_of(row[head.index("uses")]))
+    rules = {}
+    for i, (folder, names) in enumerate(zip(folders, uses)):
+        rules[folder] = {folder}
+        for name in names:
+            if name == "everything below":
+                rules[folder].update(folders[i + 1:])
+                continue
+            dep = name if name.startswith("host/") else "host/" + name
+            if dep not in folders:
+                problems.append(f'{DOC}: the row of {folder} uses "{name}", a folder with no row')
+            rules[folder].add(dep)
+    return rules, problems
+
+
+def layer_problems(root):
+    """The table's problems (layer_table), each folder of host/ with sources and no row, each
+    row with no such folder, and each include of a header from a folder its row does not
+    list under "uses"."""
+    rules, problems = layer_table(root)
+    if rules is None:
+        return problems
+    files = sources(root, "host", (".c", ".h", ".cpp"))
+    have = {os.path.dirname(module_of(f, root)) for f in files}
+    for folder in sorted(have - set(rules)):
+        problems.append(f'{folder}: no row in the table under "{LAYERS}" of {DOC}')
+    for folder in sorted(set(rules) - have):
+        problems.append(f'{DOC}: a row for {folder}, which has no sources')
+    for f, inc, target in includes(root):
+        a, b = os.path.dirname(module_of(f, root)), os.path.dirname(module_of(target, root))
+        if a in rules and b not in rules[a]:
+            allowed = ", ".join(sorted(rules[a] - {a})) or "no other folder"
+            problems.append(f"{os.path.relpath(f, root)} includes {inc} "
+                            f"({os.path.relpath(target, root)}): {a} uses {allowed}, not {b} "
+                            f'(the table under "{LAYERS}" of {DOC})')
+    return problems
+
+
 def mutual_pairs(root, graph):
     """Pairs of modules with a .c (or .cpp) each that include each other's headers."""
     def has_source(mod):
@@ -160,6 +243,9 @@ def main():
         bad += 1
     for a, b in mutual_pairs(root, graph):
         print(f"include cycle among host modules: {a} <-> {b}")
+        bad += 1
+    for problem in layer_problems(root):
+        print(problem)
         bad += 1
     for f in list(sources(root, "host", (".c", ".cpp"))) + list(sources(root, "kernels", (".cl",))):
         for name, line, length in long_functions(f):

@@ -1,7 +1,8 @@
 /* test_structure.c — the layout rules of docs/architecture.md ("The host's layers"), checked
- * by scripts/check_structure.py: no include cycle among host modules, no function in host/
- * or kernels/ over 80 lines without a reason written above it. The checker is first shown
- * to catch both on a small tree of its own. */
+ * by scripts/check_structure.py: no include cycle among host modules, each folder's includes
+ * only from the folders its row of the layers' table uses, no function in host/ or kernels/
+ * over 80 lines without a reason written above it. The checker is first shown to catch each
+ * on a small tree of its own. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,15 +24,24 @@ static void write_in(const char *dir, const char *name, const char *text)
     fclose(f);
 }
 
-/* A tree with two modules in two folders that include each other's headers and a 91-line
- * function, then without the cycle and with the function's reason stated. */
+/* A tree whose layers' table has host/x use host/y, with two modules in the two folders that
+ * include each other's headers and a 91-line function; then without the cycle and with the
+ * function's reason stated; then with host/y's row gone from the table. */
 static void test_structure_checker_catches(void)
 {
-    char root[1024], x[1100], y[1100], cmd[2300], out[8192], body[4096] = "int f(void)\n{\n";
+    char root[1024], x[1100], y[1100], docs[1100], cmd[2300], out[8192];
+    char body[4096] = "int f(void)\n{\n";
+    const char *table = "### The host's layers\n\n| folder | what | uses |\n|---|---|---|\n"
+                        "| `host/x/` | above | y |\n";
+    char layers[256];
+    snprintf(layers, sizeof layers, "%s| `host/y/` | below | — |\n", table);
     snprintf(root, sizeof root, "%s/structure", tu_tmpdir());
     snprintf(x, sizeof x, "%s/host", root);
+    snprintf(docs, sizeof docs, "%s/docs", root);
     mkdir(root, 0755);
     mkdir(x, 0755);
+    mkdir(docs, 0755);
+    write_in(docs, "architecture.md", layers);
     snprintf(x, sizeof x, "%s/host/x", root);
     snprintf(y, sizeof y, "%s/host/y", root);
     mkdir(x, 0755);
@@ -46,14 +56,22 @@ static void test_structure_checker_catches(void)
     int rc = tu_run(cmd, out, sizeof out);
     CHECK(rc == 1 && strstr(out, "include cycle among host folders: host/x <-> host/y") &&
               strstr(out, "include cycle among host modules: host/x/a <-> host/y/b") &&
+              strstr(out, "host/y/b.h includes a.h (host/x/a.h): host/y uses no other folder, "
+                          "not host/x") &&
               strstr(out, "f is 91 lines"),
-          "the checker finds both cycles and the long function (exit %d): %s", rc, out);
+          "the checker finds both cycles, the include against the table and the long function "
+          "(exit %d): %s",
+          rc, out);
     write_in(y, "b.h", "/* no includes */\n");
     char reasoned[4200] = "/* Long: one piece, as the test wants it. */\n";
     strcat(reasoned, body);
     write_in(x, "a.c", reasoned);
     rc = tu_run(cmd, out, sizeof out);
     CHECK(rc == 0, "a long function with a stated reason and no cycle pass (exit %d): %s", rc, out);
+    write_in(docs, "architecture.md", table);
+    rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "host/y: no row in the table"),
+          "a folder with no row in the table fails (exit %d): %s", rc, out);
 }
 
 /* The project itself. */
