@@ -43,7 +43,7 @@ static void print_setup(FILE *f, const StatsFrame *fr)
 {
     const Scene *s = fr->scene;
     const RenderStats *st = fr->st;
-    const Grid *g = &fr->r->grid;
+    const Grid *g = &fr->r->cs->grid;
     char feat[128];
     features_describe(st->features, feat, sizeof feat);
     if (fr->frame >= 0) fprintf(f, "frame       %d of %d\n", fr->frame, s->frames);
@@ -270,7 +270,7 @@ static void json_setup(cJSON *root, const StatsFrame *fr, int *ok)
 
 static void json_grid(cJSON *root, const StatsFrame *fr, int *ok)
 {
-    const Grid *g = &fr->r->grid;
+    const Grid *g = &fr->r->cs->grid;
     cJSON *o = obj(root, "grid", ok);
     cJSON *res = cJSON_CreateIntArray(g->n, 3);
     if (!res || !cJSON_AddItemToObject(o, "resolution", res)) {

@@ -203,7 +203,7 @@ VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3
     if (os->shell >= 0) {
         __global const VbObject *ob = sc->objects + os->shell;
         float2 c = sphere_chord(vload4(0, ob->own), org, dir, t);
-        float in = sphere_exit_inner(vload4(0, ob->plane), org, dir, t);
+        float in = sphere_exit_inner(vload4(0, ob->inside), org, dir, t);
         span = (float2)(fmin(span.x, fmax(c.x, in)), fmax(span.y, c.y));
     }
     return (float2)(fmax(span.x, 0.0f), fmin(span.y, t));
@@ -216,7 +216,7 @@ VB_INLINE float2 object_set_span(const DevScene *sc, const ObjectSet *os, float3
 VB_INLINE int object_segment_through_core(__global const VbObject *ob, float3 org, float3 dir,
                                           float t)
 {
-    float4 b = vload4(0, ob->bound), core = vload4(0, ob->plane);
+    float4 b = vload4(0, ob->bound), core = vload4(0, ob->inside);
     float3 vb = b.xyz - org;
     if (dot(vb, vb) <= b.w * b.w) return 0;
     float3 v = core.xyz - org;

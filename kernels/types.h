@@ -46,13 +46,13 @@
          * inside it is the segment clipped by their planes */
 #define VBCL_OBJECT_INNER                                                                          \
     32u /* a host of more than VBCL_OBJECT_SET_MAX_TRIS / 2 own triangles that bound a convex      \
-         * volume: VbObject.plane holds a sphere behind every plane of them (its inner sphere),    \
+         * volume: VbObject.inside holds a sphere behind every plane of them (its inner sphere),   \
          * so a ray inside it meets them only where it has left that sphere (ray_objects) */
 #define VBCL_OBJECT_SOLID                                                                          \
     8u /* a texture part that is convex, of an opaque material, strictly inside its convex         \
         * host and apart from the texture's other parts, or an opaque object (not a host) of       \
         * more than VBCL_OBJECT_SET_MAX_TRIS / 2 triangles that close a convex surface:            \
-        * VbObject.plane holds a sphere inside it (its core), and a feeler from outside its        \
+        * VbObject.inside holds a sphere inside it (its core), and a feeler from outside its       \
         * bounds that passes through the core is stopped by it, whatever it meets on the way */
 
 /* The work counters the kernels keep (at most one atomic add per work item, not per ray, into
@@ -182,9 +182,7 @@ typedef struct VbObject {
     float hi[3];
     unsigned int host;      /* a texture part's record: the object whose texture it is */
     float plane[4];         /* VBCL_OBJECT_PLANAR: unit normal n and offset k (n.x = k on
-                             * the plane); w: k. Each vertex lies within plane_eps of it.
-                             * VBCL_OBJECT_SOLID (never planar): the core, centre and radius;
-                             * VBCL_OBJECT_INNER (a host): the inner sphere, the same */
+                             * the plane); w: k. Each vertex lies within plane_eps of it */
     unsigned int first_tri; /* its own triangles: first_tri .. first_tri + ntris - 1 */
     unsigned int ntris;
     unsigned int first_tex; /* its texture's triangles */
@@ -214,6 +212,8 @@ typedef struct VbObject {
                             * meet it (part_ahead_bit). All set for a host that is not
                             * VBCL_OBJECT_HULL */
     unsigned int pad[3];
+    float inside[4]; /* a sphere inside the object, centre and radius: VBCL_OBJECT_SOLID, its
+                      * core; VBCL_OBJECT_INNER (a host), its inner sphere */
 } VbObject;
 
 /* The own triangles a host may have for a bit of VbObject.ahead each: the bits of an unsigned
@@ -405,7 +405,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbMaterial, exponent)) X(VBCL_OFFSETOF(VbMaterial, eta))                       \
     X(VBCL_OFFSETOF(VbMaterial, pattern)) X(VBCL_OFFSETOF(VbMaterial, disp))                       \
     X(sizeof(VbPattern)) X(VBCL_OFFSETOF(VbPattern, fourier)) X(VBCL_OFFSETOF(VbPattern, colours)) X(VBCL_OFFSETOF(VbPattern, axes)) X(sizeof(VbObject)) \
-    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) X(VBCL_OFFSETOF(VbObject, ahead)) \
+    X(VBCL_OFFSETOF(VbObject, bound)) X(VBCL_OFFSETOF(VbObject, lo)) X(VBCL_OFFSETOF(VbObject, plane_eps)) X(VBCL_OFFSETOF(VbObject, hi)) X(VBCL_OFFSETOF(VbObject, plane)) X(VBCL_OFFSETOF(VbObject, first_tri)) X(VBCL_OFFSETOF(VbObject, ntex)) X(VBCL_OFFSETOF(VbObject, nelems)) X(VBCL_OFFSETOF(VbObject, own)) X(VBCL_OFFSETOF(VbObject, quad_tri)) X(VBCL_OFFSETOF(VbObject, quad_tex)) X(VBCL_OFFSETOF(VbObject, ahead)) X(VBCL_OFFSETOF(VbObject, inside)) \
     X(sizeof(VbMedium)) X(sizeof(VbLight)) X(VBCL_OFFSETOF(VbLight, radiance))                     \
     X(sizeof(VbCamera)) X(sizeof(VbGrid)) X(VBCL_OFFSETOF(VbGrid, n)) X(sizeof(VbFrame))           \
     X(sizeof(VbGridCell)) X(VBCL_OFFSETOF(VbGridCell, res))                                        \
@@ -446,7 +446,8 @@ VBCL_STATIC_ASSERT(sizeof(VbGridCell) == 8, gridcell_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbGridCell, res) == 4, gridcell_res);
 VBCL_STATIC_ASSERT(sizeof(VbLeafQuad) == 160, leafquad_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbLeafQuad, tri) == 144, leafquad_tri);
-VBCL_STATIC_ASSERT(sizeof(VbObject) == 144, object_size);
+VBCL_STATIC_ASSERT(sizeof(VbObject) == 160, object_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, inside) == 144, object_inside);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, ahead) == 128, object_ahead);
 VBCL_STATIC_ASSERT(VBCL_AHEAD_BITS == 8 * sizeof(unsigned int), object_ahead_bits);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, own) == 104, object_own);

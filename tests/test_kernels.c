@@ -135,8 +135,8 @@ static void compare_grid_brute(const char *label, const char *json, const char *
     fprintf(stderr,
             "    %s, grid %s (%dx%dx%d, %u sub-grids, %u leaves): %d rays, %d hit, %d ties at "
             "equal t, %d mismatches\n",
-            label, grid, fx.r.grid.n[0], fx.r.grid.n[1], fx.r.grid.n[2], fx.r.grid.subgrids,
-            fx.r.grid.nleaves, n, hits, ties, bad);
+            label, grid, fx.r.cs->grid.n[0], fx.r.cs->grid.n[1], fx.r.cs->grid.n[2],
+            fx.r.cs->grid.subgrids, fx.r.cs->grid.nleaves, n, hits, ties, bad);
     CHECK(hits > n / 10, "%s: enough rays hit (%d of %d)", label, hits, n);
     CHECK(ties < n / 1000 + 5, "%s: ties are rare (%d)", label, ties);
     free(rays);
@@ -404,7 +404,7 @@ static void test_grid_cell_box_range(void)
         "{\"translate\": [0, -1.7, 0], \"rotate\": [10, 20, 0]}}]}";
     Fixture fx;
     if (fixture_open(&fx, json)) return;
-    const Grid *g = &fx.r.grid;
+    const Grid *g = &fx.r.cs->grid;
     enum { NQ = 2000 };
     cl_uint ntris = fx.s.mesh.ntris, nq = NQ;
     float *q = calloc(12 * NQ, sizeof *q);

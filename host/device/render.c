@@ -1,6 +1,6 @@
-/* render.c — the tracing layer: builds the grid and the kernel program for a scene,
- * uploads it (device_scene.c), and runs the tracing kernels on one batch of rays at a
- * time. The frame driver (frame.c) decides which batches make an image. */
+/* render.c — the tracing layer: builds the kernel program for a compiled scene, uploads
+ * it (device_scene.c), and runs the tracing kernels on one batch of rays at a time. The frame
+ * driver (frame.c) decides which batches make an image. */
 #include "render.h"
 
 #include <math.h>
@@ -77,22 +77,12 @@ static int renderer_program(Renderer *r, const char *source, const char *options
     return *prog ? 0 : 1;
 }
 
-/* The grid, the tracing program of the scene's class, the film program (and the probe
- * program when asked), and the kernels the scene runs. Returns 0, 1 (device) or 2 (a grid
- * the scene cannot have) with a message in err. */
+/* The tracing program of the scene's class, the film program (and the probe program when
+ * asked), and the kernels the scene runs. Returns 0 or 1 (device) with a message in err. */
 static int renderer_build(Renderer *r, const Scene *s, const char *probe_source, RenderStats *st,
                           char *err, size_t errlen)
 {
-    char gerr[256];
-    const int *res = (s->grid_res[0] > 0) ? s->grid_res : NULL;
-    const int *sub = (s->subgrid_res[0] > 0) ? s->subgrid_res : NULL;
-    if (grid_build_levels(&r->grid, &s->mesh, res, s->grid_density, sub, s->subgrid_density, gerr,
-                          sizeof gerr)) {
-        snprintf(err, errlen, "%s: grid: %s", s->path, gerr);
-        return 2;
-    }
-    st->grid_ms = r->grid.build_ms;
-    r->features = features_of_scene(s);
+    r->features = r->cs->features;
     st->features = r->features;
     st->program = features_program(r->features);
     r->program_features = features_compiled(r->features);
@@ -222,18 +212,18 @@ static int renderer_alloc_rays(Renderer *r, const Scene *s)
     return (r->program_features & VBCL_FEATURE_DISPERSION) && !r->splits;
 }
 
-int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_source,
-                  RenderStats *st, char *err, size_t errlen)
+int renderer_init_compiled(Renderer *r, VbDevice *dev, const CompiledScene *cs, const Scene *s,
+                           const char *probe_source, RenderStats *st, char *err, size_t errlen)
 {
     memset(r, 0, sizeof *r);
     r->dev = dev;
+    r->cs = cs;
+    r->frame_host = cs->frame;
     clu_error_clear();
     err[0] = '\0';
     int rc = renderer_build(r, s, probe_source, st, err, errlen);
     double t0 = clu_now_ms();
-    if (!rc)
-        rc = scene_buffers_upload(&r->buf, dev, s, &r->grid, r->features, &r->frame_host, err,
-                                  errlen);
+    if (!rc) rc = scene_buffers_upload(&r->buf, dev, cs, s, err, errlen);
     if (!rc) rc = renderer_alloc_rays(r, s);
     double t1 = clu_now_ms();
     if (!rc && renderer_first_launch(r, st)) rc = 1;
@@ -247,6 +237,27 @@ int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_
     }
     st->upload_ms = clu_now_ms() - t0;
     st->tile_pixels = r->tile_pixels;
+    return 0;
+}
+
+int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_source,
+                  RenderStats *st, char *err, size_t errlen)
+{
+    CompiledScene *cs = calloc(1, sizeof *cs);
+    if (!cs) {
+        memset(r, 0, sizeof *r);
+        snprintf(err, errlen, "out of memory");
+        return 1;
+    }
+    int rc = compiled_scene_build(cs, s, dev->max_alloc, err, errlen);
+    st->grid_ms = cs->grid.build_ms;
+    if (!rc) rc = renderer_init_compiled(r, dev, cs, s, probe_source, st, err, errlen);
+    if (rc) {
+        compiled_scene_free(cs);
+        free(cs);
+        return rc;
+    }
+    r->own_cs = cs;
     return 0;
 }
 
@@ -352,5 +363,9 @@ void renderer_release(Renderer *r)
             CL_WARN(clReleaseProgram(*progs[i]));
             *progs[i] = NULL;
         }
-    grid_free(&r->grid);
+    if (r->own_cs) {
+        compiled_scene_free(r->own_cs);
+        free(r->own_cs);
+        r->own_cs = NULL;
+    }
 }

@@ -28,6 +28,7 @@ typedef struct RenderStats {
                              * that compiles each kernel at its first launch does it here */
     int program;            /* PROGRAM_* (kernel_features.h) */
     double grid_ms, upload_ms;
+    int scene_compiles; /* compilations of the scene (compiled_scene_build) for this frame */
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
     double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
     double render_ms;     /* wall time of the tile loop */
@@ -71,8 +72,9 @@ typedef struct Renderer {
 #undef RENDER_KERNEL_FIELD
     SceneBuffers buf;
     cl_mem rays, hits, media, radiance, counters;
-    cl_mem splits; /* dispersion: one VbSplitSet per ray */
-    Grid grid;
+    cl_mem splits;           /* dispersion: one VbSplitSet per ray */
+    const CompiledScene *cs; /* the scene as compiled for the kernels (its grid: cs->grid) */
+    CompiledScene *own_cs;   /* cs where renderer_init compiled it itself, else NULL */
     VbFrame frame_host;
     int tile_pixels;
     int ray_capacity;  /* rays the ray buffers hold: the tile, and at least one 16x16 pixel */
@@ -86,12 +88,18 @@ typedef struct Renderer {
 /* The ray buffers hold at least one pixel's samples at the deepest anti-aliasing level. */
 #define RENDER_MIN_BATCH_RAYS (1 << (2 * VBCL_AA_MAX_LEVEL))
 
-/* Prepares s for rendering on dev: grid, programs (kept on dev for later frames: clu.h),
- * buffers, and one empty launch of each kernel the scene runs, so that a driver that
- * compiles a kernel at its first launch (PoCL) does so here, counted in st->build_ms and
- * not in the render. probe_source: the tests' probe program (built as the dispersive
- * class, into r->probe), or NULL. Returns 0, or 1 (device failure) / 2 (the scene cannot
- * be rendered as given, e.g. a grid too large) with a message in err. */
+/* Prepares s, compiled into cs (compiled_scene.h; the same for every device of a frame),
+ * for rendering on dev: programs (kept on dev for later frames: clu.h), buffers, and one
+ * empty launch of each kernel the scene runs, so that a driver that compiles a kernel at
+ * its first launch (PoCL) does so here, counted in st->build_ms and not in the render. cs
+ * must outlive r. probe_source: the tests' probe program (built as the dispersive class,
+ * into r->probe), or NULL. Returns 0, or 1 (device failure) / 2 (the scene cannot be
+ * rendered as given, e.g. too large for the device) with a message in err. */
+int renderer_init_compiled(Renderer *r, VbDevice *dev, const CompiledScene *cs, const Scene *s,
+                           const char *probe_source, RenderStats *st, char *err, size_t errlen);
+
+/* renderer_init_compiled on a compiled scene of its own (compiled_scene_build for dev; st
+ * gets the grid's time), for one device alone. Returns as both. */
 int renderer_init(Renderer *r, VbDevice *dev, const Scene *s, const char *probe_source,
                   RenderStats *st, char *err, size_t errlen);
 

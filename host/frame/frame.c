@@ -19,7 +19,14 @@ int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats 
         fr->work[i].index = devs[i].index;
         memcpy(fr->work[i].host, host, sizeof host);
     }
-    int rc = renderer_init(&fr->r, &devs[0], s, NULL, st, err, errlen);
+    /* one compilation of the scene for every device: the camera tiles fit the smallest */
+    size_t max_alloc = devs[0].max_alloc;
+    for (int i = 1; i < ndev; i++)
+        if (devs[i].max_alloc < max_alloc) max_alloc = devs[i].max_alloc;
+    int rc = compiled_scene_build(&fr->cs, s, max_alloc, err, errlen);
+    st->grid_ms = fr->cs.grid.build_ms;
+    st->scene_compiles++;
+    if (!rc) rc = renderer_init_compiled(&fr->r, &devs[0], &fr->cs, s, NULL, st, err, errlen);
     if (rc || ndev < 2) return rc;
     fr->more = calloc((size_t)(ndev - 1), sizeof *fr->more);
     if (!fr->more) {
@@ -29,7 +36,8 @@ int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats 
     for (int i = 1; i < ndev && !rc; i++) {
         RenderStats scratch; /* --stats reports the first device's build */
         memset(&scratch, 0, sizeof scratch);
-        rc = renderer_init(&fr->more[i - 1], &devs[i], s, NULL, &scratch, err, errlen);
+        rc = renderer_init_compiled(&fr->more[i - 1], &devs[i], &fr->cs, s, NULL, &scratch, err,
+                                    errlen);
         if (!rc) fr->nmore = i;
     }
     return rc;
@@ -107,4 +115,5 @@ void frame_release(Frame *fr)
     free(fr->more);
     fr->more = NULL;
     fr->nmore = 0;
+    compiled_scene_free(&fr->cs);
 }

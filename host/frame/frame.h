@@ -12,6 +12,7 @@
  * grows. Pass 0 runs on every device (tiles.h); refinement and supersampling run on the
  * first device's renderer r. */
 typedef struct Frame {
+    CompiledScene cs; /* the scene compiled once for every device */
     Renderer r;
     AaState aa;
     Renderer *more; /* the other devices' renderers (nmore of them) */
@@ -20,8 +21,10 @@ typedef struct Frame {
     DeviceWork work[CLU_MAX_DEVICES]; /* [0]: r's device, then more[]'s */
 } Frame;
 
-/* Prepares s on devs[0..ndev) (grid, program, buffers on each: renderer_init; st gets the
- * first device's build). Returns as renderer_init. */
+/* Prepares s on devs[0..ndev): compiles it once (compiled_scene_build: grid, object
+ * analysis, packed arrays), then builds the program and uploads the buffers on each device
+ * (renderer_init_compiled; st gets the first device's build). Returns as
+ * renderer_init_compiled. */
 int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
                size_t errlen);
 

@@ -678,7 +678,7 @@ static const char *grid_label(const Bench *b)
 
 static void report_text(const Bench *b)
 {
-    const Grid *g = &b->r.grid;
+    const Grid *g = &b->r.cs->grid;
     printf("%s: %u triangles, grid %s (%dx%dx%d), %dx%d camera rays, %u feelers per point "
            "and spherical light; vbcl on %s; %s, %d threads%s; median of %d\n",
            b->s.path, b->s.mesh.ntris, grid_label(b), g->n[0], g->n[1], g->n[2], b->s.width,
@@ -754,7 +754,7 @@ static int report_json(const Bench *b)
         fprintf(stderr, "vbcl-bench-rays: %s: cannot write\n", b->o.json);
         return -1;
     }
-    const Grid *g = &b->r.grid;
+    const Grid *g = &b->r.cs->grid;
     const char *keys[] = {"scene", "grid", "device", "embree"};
     const char *vals[] = {b->s.path, grid_label(b), b->dev.name, bench_embree_describe()};
     for (int i = 0; i < 4; i++) {
@@ -842,7 +842,8 @@ static int bench_open(Bench *b)
     }
     float diag = 0.0f;
     for (int k = 0; k < 3; k++)
-        diag += (b->r.grid.hi[k] - b->r.grid.lo[k]) * (b->r.grid.hi[k] - b->r.grid.lo[k]);
+        diag += (b->r.cs->grid.hi[k] - b->r.cs->grid.lo[k]) *
+                (b->r.cs->grid.hi[k] - b->r.cs->grid.lo[k]);
     b->tol_abs = 1e-6f * sqrtf(diag);
     if (create_kernels(b)) {
         fprintf(stderr, "vbcl-bench-rays: %s\n", clu_error());
