@@ -660,11 +660,12 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
 }
 
 /* Renders frame `frame` of the loaded scene *scene (its command line applied; freed here)
- * on devs, with the other ranks' help when d shares tiles (render_image; else NULL),
- * writes it and reports it (report_frame; *json: the --stats-json document); t0 is when
- * this frame's work began. Returns an exit status. */
+ * on devs through fr (which keeps the last frame's geometry for the next: frame_init),
+ * with the other ranks' help when d shares tiles (render_image; else NULL), writes it and
+ * reports it (report_frame; *json: the --stats-json document); t0 is when this frame's
+ * work began. Returns an exit status. */
 static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *devs, int ndev,
-                        Dist *d, double t0, cJSON **json)
+                        Dist *d, Frame *fr, double t0, cJSON **json)
 {
     char err[1024] = "";
     Scene s = *scene;
@@ -674,8 +675,6 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
     char *smap = !o->aa_samples_map ? NULL : frame_path(o->aa_samples_map, frame);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
     DeviceWork *work = calloc((size_t)max, sizeof *work);
-    Frame fr;
-    memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
     if (!out || (o->aa_map && !map) || (o->aa_samples_map && !smap) || !rgba || !work) {
@@ -685,24 +684,22 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
         goto done;
     }
     double image_wait_ms = 0.0;
-    rc = render_image(o, &s, devs, ndev, d, &fr, rgba, &st, work, &nwork, max, &image_wait_ms);
+    rc = render_image(o, &s, devs, ndev, d, fr, rgba, &st, work, &nwork, max, &image_wait_ms);
     if (rc) goto done;
     double tw = clu_now_ms();
     if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err) ||
-        (map && frame_levels(&fr) &&
-         write_aa_map(map, &s, frame_levels(&fr), 0, err, sizeof err)) ||
-        (smap && frame_leaves(&fr) &&
-         write_aa_map(smap, &s, frame_leaves(&fr), 1, err, sizeof err))) {
+        (map && frame_levels(fr) && write_aa_map(map, &s, frame_levels(fr), 0, err, sizeof err)) ||
+        (smap && frame_leaves(fr) &&
+         write_aa_map(smap, &s, frame_leaves(fr), 1, err, sizeof err))) {
         diag_print(prog, "%s", err);
         rc = 1;
         goto done;
     }
     StatsFrame sf = {
-        &s,   &devs[0], &fr.r, &st, frame, image_wait_ms, clu_now_ms() - tw, clu_now_ms() - t0,
+        &s,   &devs[0], &fr->r, &st, frame, image_wait_ms, clu_now_ms() - tw, clu_now_ms() - t0,
         work, nwork};
     rc = report_frame(o, &sf, out, json);
 done:
-    frame_release(&fr);
     free(rgba);
     free(work);
     free(out);
@@ -842,15 +839,18 @@ static int render_all(const Options *o, Dist *d, const char *text, int first, in
 {
     cJSON *json = NULL; /* the --stats-json document */
     int rc = 0, f;
+    Frame fr; /* kept from frame to frame: an animation's unchanged geometry is not rebuilt */
+    memset(&fr, 0, sizeof fr);
     if (first >= 0 && d->size > 1 && !o->stats_json) {
         while (!rc && dist_frames_next(d, first, last, &f)) {
             Scene s;
             rc = load_frame(o, text, f, &s);
-            if (!rc) rc = render_frame(o, &s, f, devs, ndev, NULL, t0, &json);
+            if (!rc) rc = render_frame(o, &s, f, devs, ndev, NULL, &fr, t0, &json);
             t0 = clu_now_ms();
         }
         if (rc) dist_frames_fail(d);
         dist_frames_end(d);
+        frame_release(&fr);
         return rc;
     }
     for (f = first; !rc && f <= last; f++) {
@@ -860,12 +860,13 @@ static int render_all(const Options *o, Dist *d, const char *text, int first, in
         else if ((rc = load_frame(o, text, f, &s)))
             break;
         if (d->rank == 0)
-            rc = render_frame(o, &s, f, devs, ndev, d, t0, &json);
+            rc = render_frame(o, &s, f, devs, ndev, d, &fr, t0, &json);
         else
             rc = render_tiles_for_rank0(d, &s, devs, ndev);
         rc = dist_agree(d, rc);
         t0 = clu_now_ms();
     }
+    frame_release(&fr);
     cJSON_Delete(json);
     return rc;
 }

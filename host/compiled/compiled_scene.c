@@ -412,6 +412,105 @@ static int grid_make(CompiledScene *cs, const Scene *s, char *err, size_t errlen
     return 2;
 }
 
+/* What an object's records depend on (objects_make): its triangles, its materials and
+ * whether its texture's material lets light through. */
+typedef struct KeyObject {
+    uint32_t first_tri, ntris, first_tex, ntex;
+    int is_host, tex_slot, material, tex_material, tex_clear;
+} KeyObject;
+
+/* The inputs of the geometry, copied: the mesh, its tags, the grid settings, the objects. */
+typedef struct GeometryKey {
+    uint32_t nverts, ntris;
+    vec3 *verts, *normals; /* normals NULL without smooth normals */
+    uint32_t *tris, *tags;
+    int grid_res[3], subgrid_res[3];
+    float grid_density, subgrid_density;
+    int nobjects;
+    KeyObject *objects;
+} GeometryKey;
+
+static void key_free(GeometryKey *k)
+{
+    if (!k) return;
+    free(k->verts);
+    free(k->normals);
+    free(k->tris);
+    free(k->tags);
+    free(k->objects);
+    free(k);
+}
+
+/* Object i of s as the key holds it. */
+static KeyObject key_object(const Scene *s, int i)
+{
+    const SceneObject *o = &s->objects[i];
+    KeyObject k;
+    memset(&k, 0, sizeof k); /* compared with memcmp */
+    k.first_tri = o->first_tri;
+    k.ntris = o->ntris;
+    k.first_tex = o->first_tex_tri;
+    k.ntex = o->ntex_tris;
+    k.is_host = o->is_host;
+    k.tex_slot = o->tex_slot;
+    k.material = o->material;
+    k.tex_material = o->tex_material;
+    k.tex_clear = o->tex_slot >= 0 && s->materials[o->tex_material].gpu.k_global > 0.0f;
+    return k;
+}
+
+/* A copy of the inputs of s's geometry, or NULL (out of memory). */
+static GeometryKey *key_make(const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    GeometryKey *k = calloc(1, sizeof *k);
+    if (!k) return NULL;
+    size_t nv = m->nverts ? m->nverts : 1, nt = m->ntris ? m->ntris : 1;
+    k->nverts = m->nverts;
+    k->ntris = m->ntris;
+    k->verts = malloc(sizeof *k->verts * nv);
+    k->normals = m->normals ? malloc(sizeof *k->normals * nv) : NULL;
+    k->tris = malloc(sizeof *k->tris * 3 * nt);
+    k->tags = malloc(sizeof *k->tags * nt);
+    k->objects = malloc(sizeof *k->objects * (size_t)(s->nobjects ? s->nobjects : 1));
+    if (!k->verts || (m->normals && !k->normals) || !k->tris || !k->tags || !k->objects) {
+        key_free(k);
+        return NULL;
+    }
+    memcpy(k->verts, m->verts, sizeof *k->verts * m->nverts);
+    if (m->normals) memcpy(k->normals, m->normals, sizeof *k->normals * m->nverts);
+    memcpy(k->tris, m->tris, sizeof *k->tris * 3 * m->ntris);
+    memcpy(k->tags, s->tri_tag, sizeof *k->tags * m->ntris);
+    memcpy(k->grid_res, s->grid_res, sizeof k->grid_res);
+    memcpy(k->subgrid_res, s->subgrid_res, sizeof k->subgrid_res);
+    k->grid_density = s->grid_density;
+    k->subgrid_density = s->subgrid_density;
+    k->nobjects = s->nobjects;
+    for (int i = 0; i < s->nobjects; i++) k->objects[i] = key_object(s, i);
+    return k;
+}
+
+/* Whether s's geometry is made of exactly the inputs of k. */
+static int key_equal(const GeometryKey *k, const Scene *s)
+{
+    const Mesh *m = &s->mesh;
+    if (!k || k->nverts != m->nverts || k->ntris != m->ntris || !k->normals != !m->normals ||
+        k->nobjects != s->nobjects || k->grid_density != s->grid_density ||
+        k->subgrid_density != s->subgrid_density ||
+        memcmp(k->grid_res, s->grid_res, sizeof k->grid_res) ||
+        memcmp(k->subgrid_res, s->subgrid_res, sizeof k->subgrid_res) ||
+        memcmp(k->verts, m->verts, sizeof *k->verts * m->nverts) ||
+        (m->normals && memcmp(k->normals, m->normals, sizeof *k->normals * m->nverts)) ||
+        memcmp(k->tris, m->tris, sizeof *k->tris * 3 * m->ntris) ||
+        memcmp(k->tags, s->tri_tag, sizeof *k->tags * m->ntris))
+        return 0;
+    for (int i = 0; i < s->nobjects; i++) {
+        KeyObject o = key_object(s, i);
+        if (memcmp(&o, &k->objects[i], sizeof o)) return 0;
+    }
+    return 1;
+}
+
 /* The geometry: grid, object records, triangles, smooth normals and quads. Returns as
  * compiled_scene_build. */
 static int geometry_make(CompiledScene *cs, const Scene *s, char *err, size_t errlen)
@@ -432,21 +531,8 @@ static int geometry_make(CompiledScene *cs, const Scene *s, char *err, size_t er
     return 1;
 }
 
-int compiled_scene_build(CompiledScene *cs, const Scene *s, size_t max_alloc, char *err,
-                         size_t errlen)
-{
-    memset(cs, 0, sizeof *cs);
-    cs->features = features_of_scene(s);
-    unsigned band_weights = 0;
-    int rc = geometry_make(cs, s, err, errlen);
-    if (!rc) rc = materials_make(cs, s, &band_weights, err, errlen);
-    if (rc) return rc;
-    frame_fill(s, &cs->grid, band_weights, &cs->frame);
-    cs->frame.flags |= features_frame_flags(cs->features);
-    return camera_tiles_make(cs, s, max_alloc, err, errlen);
-}
-
-void compiled_scene_free(CompiledScene *cs)
+/* Frees the geometry of cs (what geometry_make made, and its key). */
+static void geometry_free(CompiledScene *cs)
 {
     grid_free(&cs->grid);
     free(cs->tris);
@@ -454,9 +540,85 @@ void compiled_scene_free(CompiledScene *cs)
     free(cs->leaf_start);
     free(cs->quads);
     free(cs->objects);
+    key_free(cs->key);
+    cs->tris = NULL;
+    cs->normals = NULL;
+    cs->leaf_start = NULL;
+    cs->quads = NULL;
+    cs->objects = NULL;
+    cs->key = NULL;
+    cs->ntris = cs->nquads = 0;
+    cs->nobjects = 0;
+}
+
+/* Frees what every frame makes again: materials, patterns, texels. */
+static void shading_free(CompiledScene *cs)
+{
     free(cs->materials);
     free(cs->patterns);
     free(cs->texels);
+    cs->materials = NULL;
+    cs->patterns = NULL;
+    cs->texels = NULL;
+    cs->nmaterials = cs->npatterns = 0;
+    cs->ntexels = 0;
+}
+
+/* The camera tiles again where the geometry, the camera or the image size changed. Returns
+ * as camera_tiles_make. */
+static int camera_tiles_update(CompiledScene *cs, const Scene *s, VbCamTiles kept, size_t max_alloc,
+                               char *err, size_t errlen)
+{
+    cs->camera_tiles_built = cs->geometry_built || s->width != cs->key_width ||
+                             s->height != cs->key_height ||
+                             memcmp(&cs->frame.camera, &cs->key_camera, sizeof cs->key_camera);
+    if (!cs->camera_tiles_built) {
+        cs->frame.cam_tiles = kept;
+        return 0;
+    }
+    camtiles_free(&cs->cam);
+    memset(&cs->cam, 0, sizeof cs->cam);
+    cs->key_camera = cs->frame.camera;
+    cs->key_width = s->width;
+    cs->key_height = s->height;
+    return camera_tiles_make(cs, s, max_alloc, err, errlen);
+}
+
+int compiled_scene_update(CompiledScene *cs, const Scene *s, size_t max_alloc, char *err,
+                          size_t errlen)
+{
+    int rc = 0;
+    cs->features = features_of_scene(s);
+    cs->geometry_built = !key_equal(cs->key, s);
+    if (cs->geometry_built) {
+        geometry_free(cs);
+        rc = geometry_make(cs, s, err, errlen);
+        if (!rc && !(cs->key = key_make(s))) {
+            snprintf(err, errlen, "out of memory");
+            rc = 1;
+        }
+    }
+    shading_free(cs);
+    unsigned band_weights = 0;
+    if (!rc) rc = materials_make(cs, s, &band_weights, err, errlen);
+    if (rc) return rc;
+    VbCamTiles kept = cs->frame.cam_tiles;
+    frame_fill(s, &cs->grid, band_weights, &cs->frame);
+    cs->frame.flags |= features_frame_flags(cs->features);
+    return camera_tiles_update(cs, s, kept, max_alloc, err, errlen);
+}
+
+int compiled_scene_build(CompiledScene *cs, const Scene *s, size_t max_alloc, char *err,
+                         size_t errlen)
+{
+    memset(cs, 0, sizeof *cs);
+    return compiled_scene_update(cs, s, max_alloc, err, errlen);
+}
+
+void compiled_scene_free(CompiledScene *cs)
+{
+    geometry_free(cs);
+    shading_free(cs);
     camtiles_free(&cs->cam);
     memset(cs, 0, sizeof *cs);
 }

@@ -32,6 +32,13 @@ typedef struct CompiledScene {
     size_t ntexels;
     CamTiles cam;  /* camera tiles (cam.nx 0: none) */
     VbFrame frame; /* the frame constants; the tile fields are 0 */
+    /* What the geometry above (grid, objects, triangles, normals, quads) was made of, so
+     * that the next frame of an animation can tell whether it may keep it */
+    struct GeometryKey *key;
+    VbCamera key_camera; /* and the camera tiles: the camera and image they were made for */
+    int key_width, key_height;
+    /* this frame: whether the geometry and the camera tiles were made (1) or kept (0) */
+    int geometry_built, camera_tiles_built;
 } CompiledScene;
 
 /* Compiles s into cs for devices of which none takes an allocation above max_alloc bytes
@@ -40,6 +47,15 @@ typedef struct CompiledScene {
  * cs holds what was made either way (compiled_scene_free frees it). */
 int compiled_scene_build(CompiledScene *cs, const Scene *s, size_t max_alloc, char *err,
                          size_t errlen);
+
+/* Compiles s, the next frame of an animation, into cs, which holds the frame before: where
+ * s has the same geometry (mesh, triangle tags, grid settings, objects and the transparency
+ * of their textures' materials) it keeps the grid, object records, triangles and quads, and
+ * where the camera and image size are the same too, the camera tiles; it makes the
+ * materials, patterns, band tables and frame constants again. An empty cs (zeroed, or after
+ * compiled_scene_free) is compiled whole. Returns as compiled_scene_build. */
+int compiled_scene_update(CompiledScene *cs, const Scene *s, size_t max_alloc, char *err,
+                          size_t errlen);
 
 /* Frees everything of cs and zeroes it. */
 void compiled_scene_free(CompiledScene *cs);

@@ -28,7 +28,8 @@ typedef struct RenderStats {
                              * that compiles each kernel at its first launch does it here */
     int program;            /* PROGRAM_* (kernel_features.h) */
     double grid_ms, upload_ms;
-    int scene_compiles; /* compilations of the scene (compiled_scene_build) for this frame */
+    int scene_compiles;  /* compilations of the scene (compiled_scene_update) for this frame */
+    int geometry_builds; /* of them, those that made the geometry (the others kept it) */
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
     double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
     double render_ms;     /* wall time of the tile loop */

@@ -8,24 +8,38 @@
 #include <string.h>
 #include <unistd.h>
 
+/* Releases the devices' renderers and the anti-aliasing state, keeping fr->cs. */
+static void frame_release_devices(Frame *fr)
+{
+    aa_release(&fr->aa);
+    renderer_release(&fr->r);
+    for (int i = 0; i < fr->nmore; i++) renderer_release(&fr->more[i]);
+    free(fr->more);
+    fr->more = NULL;
+    fr->nmore = 0;
+}
+
 int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
                size_t errlen)
 {
-    memset(fr, 0, sizeof *fr);
+    frame_release_devices(fr);
     char host[sizeof fr->work[0].host] = "";
     if (gethostname(host, sizeof host - 1)) host[0] = 0;
     for (int i = 0; i < ndev && i < CLU_MAX_DEVICES; i++) {
+        memset(&fr->work[i], 0, sizeof fr->work[i]);
         snprintf(fr->work[i].name, sizeof fr->work[i].name, "%s", devs[i].name);
         fr->work[i].index = devs[i].index;
         memcpy(fr->work[i].host, host, sizeof host);
     }
-    /* one compilation of the scene for every device: the camera tiles fit the smallest */
+    /* one compilation of the scene for every device (the camera tiles fit the smallest),
+     * keeping the last frame's geometry where it is the same */
     size_t max_alloc = devs[0].max_alloc;
     for (int i = 1; i < ndev; i++)
         if (devs[i].max_alloc < max_alloc) max_alloc = devs[i].max_alloc;
-    int rc = compiled_scene_build(&fr->cs, s, max_alloc, err, errlen);
-    st->grid_ms = fr->cs.grid.build_ms;
+    int rc = compiled_scene_update(&fr->cs, s, max_alloc, err, errlen);
     st->scene_compiles++;
+    st->geometry_builds += fr->cs.geometry_built;
+    st->grid_ms = fr->cs.geometry_built ? fr->cs.grid.build_ms : 0.0;
     if (!rc) rc = renderer_init_compiled(&fr->r, &devs[0], &fr->cs, s, NULL, st, err, errlen);
     if (rc || ndev < 2) return rc;
     fr->more = calloc((size_t)(ndev - 1), sizeof *fr->more);
@@ -109,11 +123,6 @@ const int *frame_leaves(const Frame *fr)
 
 void frame_release(Frame *fr)
 {
-    aa_release(&fr->aa);
-    renderer_release(&fr->r);
-    for (int i = 0; i < fr->nmore; i++) renderer_release(&fr->more[i]);
-    free(fr->more);
-    fr->more = NULL;
-    fr->nmore = 0;
+    frame_release_devices(fr);
     compiled_scene_free(&fr->cs);
 }

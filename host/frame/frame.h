@@ -21,10 +21,11 @@ typedef struct Frame {
     DeviceWork work[CLU_MAX_DEVICES]; /* [0]: r's device, then more[]'s */
 } Frame;
 
-/* Prepares s on devs[0..ndev): compiles it once (compiled_scene_build: grid, object
- * analysis, packed arrays), then builds the program and uploads the buffers on each device
- * (renderer_init_compiled; st gets the first device's build). Returns as
- * renderer_init_compiled. */
+/* Prepares s on devs[0..ndev): compiles it (compiled_scene_update: grid, object analysis,
+ * packed arrays, once for every device, the geometry kept from fr's last frame where it is
+ * the same), then builds the program and uploads the buffers on each device
+ * (renderer_init_compiled; st gets the first device's build). fr is zeroed before its first
+ * frame and released (frame_release) after its last. Returns as renderer_init_compiled. */
 int frame_init(Frame *fr, VbDevice *devs, int ndev, const Scene *s, RenderStats *st, char *err,
                size_t errlen);
 
@@ -53,7 +54,7 @@ const int *frame_levels(const Frame *fr);
  * NULL. */
 const int *frame_leaves(const Frame *fr);
 
-/* Releases everything frame_init and frame_render created. */
+/* Releases everything frame_init and frame_render created, the compiled scene included. */
 void frame_release(Frame *fr);
 
 #endif
