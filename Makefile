@@ -53,7 +53,7 @@ VBCL_OBJ := $(MAIN_OBJ) $(filter-out $(BUILD)/host/util/image_io.o,$(LIB_OBJ)) \
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/tests/%.o,$(wildcard tests/*.c))
 KERNELS  := $(wildcard kernels/*.cl kernels/*.h)
 
-.PHONY: all run test deps format format-check clean bench bench-grid gallery stress oclgrind fuzz FORCE test-drivers
+.PHONY: all run test deps test-deps format format-check clean bench bench-grid gallery stress oclgrind fuzz FORCE test-drivers
 all: vbcl
 
 build/config.mk: scripts/install-deps.sh Makefile
@@ -74,6 +74,10 @@ build/config.mk: scripts/install-deps.sh Makefile
 
 deps:
 	scripts/install-deps.sh
+
+# What the tests, the checks and the scripts need besides (install-deps.sh --test).
+test-deps:
+	$(Q)scripts/install-deps.sh --test
 
 # ./vbcl is always the plain build; a sanitized one stays in build/san/vbcl.
 ifeq ($(SANITIZE),)
@@ -180,7 +184,7 @@ SAN_ENV := $(if $(SANITIZE),LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:
 # (vbcl-tests -j), one a core up to 4 by default; --warm-cache compiles the kernels while
 # the test binaries build.
 TEST_JOBS ?= $(shell n=$$(nproc); echo $$((n < 4 ? n : 4)))
-test:
+test: test-deps
 	$(Q)$(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl
 	$(Q)$(SAN_ENV) $(BUILD)/vbcl --warm-cache & warm=$$!; \
 	  $(MAKE) --no-print-directory -j$$(nproc) $(BUILD)/vbcl-tests $(BUILD)/vbcl-bench-rays \
@@ -197,7 +201,7 @@ endif
 # The thesis's appendix figures A.1 ... A.8 at their own settings (400x400), one at a time:
 # PNG files in docs/images/thesis/ and the README's gallery table with each render's measured
 # time, samples per pixel and rays (scripts/gallery.py; about 4 minutes on 2 cores).
-gallery: vbcl
+gallery: vbcl | test-deps
 	scripts/gallery.py --vbcl ./vbcl --out docs/images/thesis --readme README.md
 
 # The benchmarks (scripts/bench.py; docs/benchmarks.md): the thesis's section 4.1.5 table on
@@ -253,7 +257,7 @@ stress: $(BUILD)/vbcl-stress $(BUILD)/vbcl
 # The kernels under oclgrind on the smallest scene (fails on any error it reports), and the
 # same image on PoCL and on oclgrind, a second OpenCL implementation (docs/testing.md).
 OCLGRIND_FLAGS ?= --check-api --data-races
-oclgrind: $(BUILD)/vbcl
+oclgrind: $(BUILD)/vbcl | test-deps
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny.json "$(OCLGRIND_FLAGS)"
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_glass.json "$(OCLGRIND_FLAGS)" 1e-3
 	$(Q)scripts/oclgrind_check.sh $(BUILD)/vbcl tests/scenes/tiny_aa.json "$(OCLGRIND_FLAGS)"
@@ -278,7 +282,7 @@ FUZZ_SRC     := $(wildcard host/scene/*.c) host/util/diag.c host/geom/mesh.c hos
                 host/geom/mesh_io.c host/geom/shapes.c host/accel/grid.c host/util/cache.c \
                 host/texgen/texgen_args.c host/texgen/texgen_bomb.c host/texgen/texgen_deform.c \
                 host/texgen/texgen_set.c host/util/fileio.c
-build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk | test-deps
 	@mkdir -p $(dir $@)
 	@echo "  FUZZ    $@"
 	$(Q)$(FUZZ_CC) $(CSTD) -g -O1 $(WARN) -Wno-unknown-warning-option \

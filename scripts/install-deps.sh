@@ -1,21 +1,28 @@
 #!/bin/sh
 # install-deps.sh — installs what vbcl needs from Debian's packages, only what is missing.
 # Idempotent: a second run installs nothing. Uses sudo when not root.
-# usage: scripts/install-deps.sh [--bench]
-#   --bench  also what only `make bench` needs: Embree 3 (libembree-dev), which the bench part
-#            "embree" traces the same rays with (docs/benchmarks.md); the renderer never links it.
+# usage: scripts/install-deps.sh [--test | --bench]
+#   (none)   what building and rendering need (`make run`): a compiler, OpenCL with PoCL,
+#            cJSON, OpenImageIO, OpenMPI (vbcl is built with MPI where it is installed)
+#   --test   and what the tests and checks need (`make test`, `make oclgrind`, `make fuzz`):
+#            clinfo, oclgrind, clang (the fuzzers), OpenImageIO's tools (idiff), Python
+#            with NumPy and Matplotlib (the gallery and bench scripts)
+#   --bench  and, for `make bench`, Embree 3 (libembree-dev), which the bench part "embree"
+#            traces the same rays with (docs/benchmarks.md); the renderer never links it.
 set -eu
 
-PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo oclgrind clang \
-libcjson-dev libopenimageio-dev openimageio-tools python3 python3-numpy python3-matplotlib python3-venv \
-libopenmpi-dev openmpi-bin"
+PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd \
+libcjson-dev libopenimageio-dev libopenmpi-dev openmpi-bin"
+TEST_PACKAGES="clinfo oclgrind clang openimageio-tools python3 python3-numpy python3-matplotlib \
+python3-venv"
 BENCH_PACKAGES="libembree-dev"
 
 case "${1:-}" in
 "") ;;
---bench) PACKAGES="$PACKAGES $BENCH_PACKAGES" ;;
+--test) PACKAGES="$PACKAGES $TEST_PACKAGES" ;;
+--bench) PACKAGES="$PACKAGES $TEST_PACKAGES $BENCH_PACKAGES" ;;
 *)
-    echo "usage: scripts/install-deps.sh [--bench]" >&2
+    echo "usage: scripts/install-deps.sh [--test | --bench]" >&2
     exit 2
     ;;
 esac
