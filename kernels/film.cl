@@ -22,45 +22,6 @@ __kernel void aa_reconstruct(__constant const VbAaPass *aa, __global const float
     vstore4(sum * (1.0f / (float)n), aa->first + j, film);
 }
 
-/* The contrast test of pixel p (x, y) in a round (aa_contrast_mark, aa_contrast_list): an
- * unsplit pixel against its neighbours, or each leaf of a split one below the top level
- * against its adjacent leaves (aa_leaf_fails), after round 0 only the leaves that lie in or
- * next to a block split last round (aa_leaf_touched; last: the last round's half of split).
- * A failing leaf is appended to marks as (pixel, node code); counts[0] counts the marks,
- * counts[1 + l] those at level l. */
-VB_INLINE void aa_contrast_pixel(__constant const VbAaPass *aa, __global const float *film,
-                                 __global const int *slots, AaTree tree, __global uint2 *marks,
-                                 __global uint *counts, __global const uint *last, int p)
-{
-    int x = p % aa->width, y = p / aa->width, slot = slots[p], all_plain = 0;
-    if (slot < 0) {
-        float3 a = aa_display(aa, vload4(p, film).xyz);
-        int fails = aa_plain_pixel_fails(aa, film, slots, x, y, a, &all_plain);
-        if (all_plain ? !fails
-                      : !aa_leaf_fails(aa, film, slots, tree, x * AA_TREE_SIDE, y * AA_TREE_SIDE,
-                                       AA_TREE_SIDE, 0, a))
-            return;
-        uint m = atomic_inc(&counts[0]);
-        atomic_inc(&counts[1]);
-        marks[m] = (uint2)((uint)p, aa_node_code(0, 0, 0));
-        return;
-    }
-    __global const uchar *own = tree.levels + (size_t)slot * VBCL_AA_CELLS;
-    for (int fy = 0; fy < AA_TREE_SIDE; fy++) /* each row one leaf at a time */
-        for (int fx = 0; fx < AA_TREE_SIDE;) {
-            int lv = own[fy * AA_TREE_SIDE + fx], s = AA_TREE_SIDE >> lv, at = fx;
-            fx += s;
-            if (lv >= aa->max_level || fy % s) continue; /* not the leaf's first row */
-            int X0 = x * AA_TREE_SIDE + at, Y0 = y * AA_TREE_SIDE + fy;
-            if (aa->round > 0 && !aa_leaf_touched(aa, last, X0, Y0, s)) continue;
-            float3 c = vload4(aa_cell_value(tree.cap, slot, lv, at, fy), tree.values).xyz;
-            if (!aa_leaf_fails(aa, film, slots, tree, X0, Y0, s, lv, aa_display(aa, c))) continue;
-            uint m = atomic_inc(&counts[0]);
-            atomic_inc(&counts[1 + lv]);
-            marks[m] = (uint2)((uint)p, aa_node_code(lv, at / s, fy / s));
-        }
-}
-
 /* film, slots, trees, split -> marks, counts: the contrast test (aa_contrast_pixel) over the
  * whole image: in round 0 every pixel, later those whose neighbourhood was split last round
  * (aa_pixel_dirty). split holds two rounds' blocks, the last round's read and this round's
@@ -127,27 +88,8 @@ __kernel void aa_split_store(__constant const VbAaPass *aa, __global const uint2
 {
     uint j = get_global_id(0);
     if (j >= aa->entries) return;
-    uint2 m = marks[aa->first + j];
-    int lv = aa_node_level(m.y) + 1, slot = slots[m.x];
-    atomic_or(&split[aa->round % 2 * aa->width * aa->height + (int)m.x], aa_node_blocks(m.y));
-    if (slot < 0) {
-        slot = (int)atomic_inc(&counts[VBCL_AA_MAX_LEVEL + 1]);
-        slots[m.x] = slot;
-        slot_pixels[slot] = (int)m.x;
-    }
-    uint cap = aa->tree_cap;
-    int keep = aa_kept_index(m.y);
-    float4 v =
-        lv == 1 ? vload4(m.x, film)
-                : vload4(aa_node_value(cap, slot, lv - 1, aa_node_x(m.y), aa_node_y(m.y)), values);
-    aa_fill_levels(levels + (size_t)slot * VBCL_AA_CELLS, m.y, lv);
-    for (int c = 0; c < 4; c++) { /* the kept child the node's value, the others (in
-                                   * aa_new_child's order) the new samples */
-        uint child = aa_child(m.y, c);
-        float4 cv = c == keep ? v : vload4(3 * j + (uint)(c < keep ? c : c - 1), radiance);
-        vstore4((float4)(cv.xyz, 0.0f),
-                aa_node_value(cap, slot, lv, aa_node_x(child), aa_node_y(child)), values);
-    }
+    aa_split_node(aa, marks[aa->first + j], j, radiance, film, slots, slot_pixels, levels, values,
+                  counts, split);
 }
 
 /* levels, values, slot_pixels, slots -> film, info: each refined pixel becomes the mean of
@@ -162,42 +104,11 @@ __kernel void aa_resolve(__constant const VbAaPass *aa, __global const int *slot
 {
     uint slot = get_global_id(0);
     if (slot >= aa->entries) return;
-    __global const uchar *own = levels + (size_t)slot * VBCL_AA_CELLS;
-    uint leaf[AA_EXT_MAX];
-    float w[AA_EXT_MAX];
-    uint cap = aa->tree_cap;
-    int p = slot_pixels[slot];
-    int deepest = 0, nown = aa_leaf_list(own, leaf, &deepest);
-    float3 sum = (float3)(0.0f);
-    if (aa->reconstruct == 1) { /* each cell the value of the leaf covering it */
-        for (int k = 0; k < VBCL_AA_CELLS; k++)
-            sum += vload4(aa_cell_value(cap, (int)slot, own[k], k % AA_TREE_SIDE, k / AA_TREE_SIDE),
-                          values)
-                       .xyz;
-    } else {
-        int x = p % aa->width, y = p / aa->width, n = nown, from[9];
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
-                int q = (y + dy) * aa->width + x + dx, src = (dy + 1) * 3 + dx + 1;
-                from[src] = (int)slot;
-                if (src == (int)AA_OWN || x + dx < 0 || x + dx >= aa->width || y + dy < 0 ||
-                    y + dy >= aa->height || slots[q] < 0)
-                    continue;
-                from[src] = slots[q];
-                n = aa_band_list(levels + (size_t)slots[q] * VBCL_AA_CELLS, dx, dy, leaf, n);
-            }
-        aa_nearest_weights(leaf, n, nown, w);
-        for (int i = 0; i < n; i++)
-            if (w[i] > 0.0f) {
-                int at = (int)(leaf[i] >> 16 & 255u), lv = (int)(leaf[i] >> 24 & 15u);
-                sum += w[i] * vload4(aa_cell_value(cap, from[leaf[i] >> 28], lv, at % AA_TREE_SIDE,
-                                                   at / AA_TREE_SIDE),
-                                     values)
-                                  .xyz;
-            }
-    }
+    int p = slot_pixels[slot], deepest = 0, nleaves = 0;
+    AaTree tree = {levels, values, aa->tree_cap};
+    float3 sum = aa_resolve_pixel(aa, tree, slots, (int)slot, p, &deepest, &nleaves);
     vstore4((float4)(sum * (1.0f / (float)VBCL_AA_CELLS), 1.0f), p, film);
-    info[p] = deepest | nown << 8;
+    info[p] = deepest | nleaves << 8;
 }
 
 #endif
