@@ -15,6 +15,7 @@
 #include "harness.h"
 #include "image_io.h"
 #include "testutil.h"
+#include "types.h"
 
 #define GOOD_SCENE                                                                                 \
     "{\"image\": {\"width\": 24, \"height\": 16},\n"                                               \
@@ -1148,6 +1149,14 @@ static void test_cli_stats_json(void)
           json_num(doc, "scene", "triangles", NULL), tris);
     CHECK(json_num(doc, "grid", "cells", NULL) == cells, "grid.cells %g, text %u",
           json_num(doc, "grid", "cells", NULL), cells);
+    /* every kernel counter, under the group and key its VBCL_COUNTER_LIST entry gives */
+    int counters = 0, found = 0;
+#define CLI_COUNTER(name, index, field, group, key)                                                \
+    counters++;                                                                                    \
+    found += !isnan(json_num(doc, #group, key, NULL));
+    VBCL_COUNTER_LIST(CLI_COUNTER)
+#undef CLI_COUNTER
+    CHECK(found == counters, "--stats-json has %d of the %d counters", found, counters);
     double mean = json_num(doc, "samples", "per_pixel_mean", NULL);
     CHECK(fabs(mean - spp) <= 0.005, "samples.per_pixel_mean %g, text %.2f", mean, spp);
     CHECK(json_num(doc, "samples", "per_pixel_max", NULL) == spp_max,
