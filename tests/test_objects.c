@@ -1,0 +1,466 @@
+/* test_objects.c — the object analysis (host/compiled/objects.c) on small scenes, without an
+ * OpenCL device: convexity and hulls, planes, bounds. Every expectation is computed here
+ * from the scene's vertices, not taken from the records. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "objects.h"
+#include "scene.h"
+#include "testutil.h"
+
+/* A camera 20 units from the origin (the scene's frame is the file's own), an opaque
+ * material m, an opaque texture material stone used by no object, and two dielectrics. */
+#define OBJECTS_SCENE_HEAD                                                                         \
+    "{\"camera\": {\"eye\": [0, 0, 20], \"look_at\": [0, 0, 0]},\n"                                \
+    " \"materials\": {\"m\": {}, \"stone\": {\"diffuse\": [0.5, 0.4, 0.3]},\n"                     \
+    "  \"glass\": {\"k_global\": 0.9, \"eta\": 1.5}, \"clear\": {\"k_global\": 0.5, \"eta\": "     \
+    "1.2}},\n"
+
+/* A texture whose block [-1, 1]^3 maps onto a host box of [-1, 1]^3 unchanged. */
+#define IDENTITY_BLOCK "\"block\": [-1, -1, -1, 1, 1, 1]"
+
+/* ---- OBJ text built piece by piece ---- */
+
+typedef struct Obj {
+    char *text;
+    size_t len, cap;
+    int nv; /* vertices written so far: the next is nv + 1 */
+} Obj;
+
+static void obj_add(Obj *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void obj_add(Obj *o, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0) return;
+    if (o->len + (size_t)n + 1 > o->cap) {
+        size_t cap = 2 * (o->len + (size_t)n + 1);
+        char *t = realloc(o->text, cap);
+        if (!t) return;
+        o->text = t;
+        o->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(o->text + o->len, o->cap - o->len, fmt, ap);
+    va_end(ap);
+    o->len += (size_t)n;
+}
+
+/* The six corners of an octahedron of centre c and radius r (c +- r along each axis); the
+ * index of the first, +x (then -x, +y, -y, +z, -z). */
+static int obj_octahedron_corners(Obj *o, double cx, double cy, double cz, double r)
+{
+    int b = o->nv + 1;
+    obj_add(o, "v %.9g %.9g %.9g\nv %.9g %.9g %.9g\n", cx + r, cy, cz, cx - r, cy, cz);
+    obj_add(o, "v %.9g %.9g %.9g\nv %.9g %.9g %.9g\n", cx, cy + r, cz, cx, cy - r, cz);
+    obj_add(o, "v %.9g %.9g %.9g\nv %.9g %.9g %.9g\n", cx, cy, cz + r, cx, cy, cz - r);
+    o->nv += 6;
+    return b;
+}
+
+/* Face s (0 .. 7: bit k set, the minus side of axis k) of the octahedron whose corners
+ * start at b, outward. */
+static void obj_octahedron_face(Obj *o, int b, int s)
+{
+    int x = b + (s & 1), y = b + 2 + (s >> 1 & 1), z = b + 4 + (s >> 2 & 1);
+    if ((s & 1) ^ (s >> 1 & 1) ^ (s >> 2 & 1)) /* an odd number of minus sides: mirrored */
+        obj_add(o, "f %d %d %d\n", x, z, y);
+    else
+        obj_add(o, "f %d %d %d\n", x, y, z);
+}
+
+/* An octahedron of centre c and radius r, outward. */
+static void obj_octahedron(Obj *o, double cx, double cy, double cz, double r)
+{
+    int b = obj_octahedron_corners(o, cx, cy, cz, r);
+    for (int s = 0; s < 8; s++) obj_octahedron_face(o, b, s);
+}
+
+/* An axis-aligned box [lo, hi], outward, its faces as quads (two triangles each). */
+static void obj_box(Obj *o, const double lo[3], const double hi[3])
+{
+    int b = o->nv + 1; /* corner (i, j, k) of x, y, z is b + i + 2j + 4k */
+    for (int c = 0; c < 8; c++)
+        obj_add(o, "v %.9g %.9g %.9g\n", c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1],
+                c & 4 ? hi[2] : lo[2]);
+    o->nv += 8;
+    static const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                    {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (int f = 0; f < 6; f++)
+        obj_add(o, "f %d %d %d %d\n", b + faces[f][0], b + faces[f][1], b + faces[f][2],
+                b + faces[f][3]);
+}
+
+/* An L-shaped prism, outward: the polygon (0,0) (2,0) (2,1) (1,1) (1,2) (0,2) scaled by s,
+ * from z = -s/4 to s/4, moved by (x, y, z). Not convex: (1,1) is a reflex corner. */
+static void obj_ell(Obj *o, double x, double y, double z, double s)
+{
+    static const double poly[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+    int b = o->nv + 1; /* corner i at the bottom is b + i, at the top b + 6 + i */
+    for (int top = 0; top < 2; top++)
+        for (int i = 0; i < 6; i++)
+            obj_add(o, "v %.9g %.9g %.9g\n", x + s * poly[i][0], y + s * poly[i][1],
+                    z + (top ? s : -s) / 4);
+    o->nv += 12;
+    /* the caps fanned from corner 0, which sees every other corner */
+    obj_add(o, "f %d %d %d %d %d %d\n", b + 6, b + 7, b + 8, b + 9, b + 10, b + 11);
+    obj_add(o, "f %d %d %d %d %d %d\n", b, b + 5, b + 4, b + 3, b + 2, b + 1);
+    for (int i = 0; i < 6; i++) {
+        int j = (i + 1) % 6;
+        obj_add(o, "f %d %d %d %d\n", b + i, b + j, b + 6 + j, b + 6 + i);
+    }
+}
+
+/* Writes o to the test directory as name and frees its text. */
+static void obj_write(Obj *o, const char *name)
+{
+    tu_write_file(name, o->text ? o->text : "");
+    free(o->text);
+    memset(o, 0, sizeof *o);
+}
+
+/* ---- geometry, in double precision from the float vertices ---- */
+
+static vec3 corner(const Mesh *m, uint32_t t, int k)
+{
+    return m->verts[m->tris[3 * t + k]];
+}
+
+/* The unit normal n and offset k (n.x = k) of triangle t's plane; 0 where it is degenerate. */
+static int tri_plane(const Mesh *m, uint32_t t, double n[3], double *k)
+{
+    vec3 a = corner(m, t, 0), b = corner(m, t, 1), c = corner(m, t, 2);
+    double e[3] = {(double)b.x - a.x, (double)b.y - a.y, (double)b.z - a.z};
+    double f[3] = {(double)c.x - a.x, (double)c.y - a.y, (double)c.z - a.z};
+    n[0] = e[1] * f[2] - e[2] * f[1];
+    n[1] = e[2] * f[0] - e[0] * f[2];
+    n[2] = e[0] * f[1] - e[1] * f[0];
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0)) return 0;
+    for (int a2 = 0; a2 < 3; a2++) n[a2] /= len;
+    *k = n[0] * a.x + n[1] * a.y + n[2] * a.z;
+    return 1;
+}
+
+static double height(const double n[3], double k, double x, double y, double z)
+{
+    return n[0] * x + n[1] * y + n[2] * z - k;
+}
+
+/* The greatest height of a vertex of triangles vf .. vf + vn - 1 above the plane of
+ * triangle t (negative: every one lies behind it). */
+static double max_height_one(const Mesh *m, uint32_t t, uint32_t vf, uint32_t vn)
+{
+    double n[3], k, worst = -INFINITY;
+    if (!tri_plane(m, t, n, &k)) return INFINITY;
+    for (uint32_t u = vf; u < vf + vn; u++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = corner(m, u, j);
+            worst = fmax(worst, height(n, k, v.x, v.y, v.z));
+        }
+    return worst;
+}
+
+/* The same over the planes of triangles first .. first + n - 1: at most 0 (within rounding)
+ * where every vertex lies behind or on every plane. */
+static double max_height(const Mesh *m, uint32_t first, uint32_t n, uint32_t vf, uint32_t vn)
+{
+    double worst = -INFINITY;
+    for (uint32_t t = first; t < first + n; t++) worst = fmax(worst, max_height_one(m, t, vf, vn));
+    return worst;
+}
+
+/* The bounding box of the vertices of triangles first .. first + n - 1, grown into lo, hi. */
+static void tri_box(const Mesh *m, uint32_t first, uint32_t n, double lo[3], double hi[3])
+{
+    for (uint32_t t = first; t < first + n; t++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = corner(m, t, j);
+            const double c[3] = {v.x, v.y, v.z};
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], c[a]);
+                hi[a] = fmax(hi[a], c[a]);
+            }
+        }
+}
+
+static double dist3(const double a[3], vec3 v)
+{
+    double d[3] = {v.x - a[0], v.y - a[1], v.z - a[2]};
+    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+/* ---- scenes ---- */
+
+/* Writes json as name in the test directory, loads it and analyses it: 0 with *s loaded
+ * and *rec (n records) allocated, -1 (a failed check) otherwise. */
+static int load_objects(const char *name, const char *json, Scene *s, VbObject **rec, size_t *n)
+{
+    char err[1024] = "";
+    int rc = scene_load(tu_write_file(name, json), s, err, sizeof err);
+    CHECK(rc == 0, "%s loads: %s", name, err);
+    if (rc) return -1;
+    *rec = objects_make(s, n);
+    CHECK(*rec != NULL, "objects_make gives records for %s", name);
+    if (!*rec) {
+        scene_free(s);
+        return -1;
+    }
+    return 0;
+}
+
+static int has(const VbObject *g, unsigned flag)
+{
+    return (g->flags & flag) != 0;
+}
+
+/* The size of an object for tolerances: the largest coordinate of its box plus its half
+ * diagonal, as both the own and the texture's triangles give it. */
+static double object_size(const Mesh *m, const SceneObject *o)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    tri_box(m, o->first_tri, o->ntris, lo, hi);
+    tri_box(m, o->first_tex_tri, o->ntex_tris, lo, hi);
+    double mag = 0.0, d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        mag = fmax(mag, fmax(fabs(lo[a]), fabs(hi[a])));
+        d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    return mag + 0.5 * sqrt(d2);
+}
+
+/* ---- convexity and hulls ---- */
+
+/* A textured glass box (its texture, two octahedra, inside it), a textured glass L-shaped
+ * prism, an opaque box, an opaque L-shaped prism and a glass box whose texture reaches out
+ * of it: VBCL_OBJECT_CONVEX exactly where every vertex of the object and its texture lies
+ * behind (or within 1e-6 of the size of) every plane of its own triangles (the first and the
+ * opaque box), VBCL_OBJECT_HULL exactly on the hosts with parts whose own triangles alone are
+ * convex so (both textured boxes, not the L); the L host's parts keep every ahead bit. */
+static void test_objects_hulls(void)
+{
+    Obj tex = {0}, out = {0}, ell = {0};
+    obj_octahedron(&tex, -0.4, 0, 0, 0.3);
+    obj_octahedron(&tex, 0.4, 0, 0, 0.3);
+    obj_write(&tex, "hull_tex.obj");
+    obj_octahedron(&out, 0.9, 0, 0, 0.3);
+    obj_write(&out, "hull_out_tex.obj");
+    obj_ell(&ell, 0, 0, 0, 1.0);
+    obj_write(&ell, "ell.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [-4, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"hull_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"mesh\", \"file\": \"ell.obj\", \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [3, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"hull_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [0, 4, 0]}},\n"
+        "  {\"shape\": \"mesh\", \"file\": \"ell.obj\", \"material\": \"m\",\n"
+        "   \"transform\": {\"translate\": [0, -5, 0]}},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [0, 0, -6]},\n"
+        "   \"texture\": {\"file\": \"hull_out_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("hulls.json", json, &s, &rec, &n)) return;
+    const Mesh *m = &s.mesh;
+    for (int i = 0; i < s.nobjects; i++) {
+        const SceneObject *o = &s.objects[i];
+        double eps = 1e-6 * object_size(m, o);
+        double own = max_height(m, o->first_tri, o->ntris, o->first_tri, o->ntris);
+        double all =
+            fmax(own, max_height(m, o->first_tri, o->ntris, o->first_tex_tri, o->ntex_tris));
+        int hull = o->is_host && rec[i].nelems > 0 && own <= eps;
+        fprintf(stderr,
+                "    %s: %u triangles, texture %u, highest vertex %.3g above an own plane\n",
+                o->name, o->ntris, o->ntex_tris, all);
+        CHECK(has(&rec[i], VBCL_OBJECT_CONVEX) == (all <= eps),
+              "%s: CONVEX %d, a vertex %.3g above a plane", o->name,
+              has(&rec[i], VBCL_OBJECT_CONVEX), all);
+        CHECK(has(&rec[i], VBCL_OBJECT_HULL) == hull, "%s: HULL %d, expected %d", o->name,
+              has(&rec[i], VBCL_OBJECT_HULL), hull);
+    }
+    /* the fixture itself: what the rules must say of these five */
+    CHECK(has(&rec[0], VBCL_OBJECT_HULL) && has(&rec[0], VBCL_OBJECT_CONVEX),
+          "the textured box is a hull and convex");
+    CHECK(!has(&rec[1], VBCL_OBJECT_HULL) && !has(&rec[1], VBCL_OBJECT_CONVEX),
+          "the textured L is neither a hull nor convex");
+    CHECK(has(&rec[2], VBCL_OBJECT_CONVEX) && !has(&rec[3], VBCL_OBJECT_CONVEX),
+          "the opaque box is convex, the opaque L not");
+    CHECK(has(&rec[4], VBCL_OBJECT_HULL) && !has(&rec[4], VBCL_OBJECT_CONVEX),
+          "the box whose texture reaches out is a hull, not convex");
+    CHECK(rec[1].nelems == 2, "the L's texture has two parts (%u)", rec[1].nelems);
+    for (unsigned e = 0; e < rec[1].nelems; e++)
+        CHECK(rec[rec[1].first_elem + e].ahead == ~0u,
+              "a part of a host that is no hull keeps every ahead bit (part %u: %#x)", e,
+              rec[rec[1].first_elem + e].ahead);
+    free(rec);
+    scene_free(&s);
+}
+
+/* ---- planes ---- */
+
+/* A quad of 2 x 3 turned by (30, 0, 20) degrees and moved to (1, 2, 3), and a box: the quad
+ * is VBCL_OBJECT_PLANAR with a unit normal that is its triangles' (the rotated +y axis,
+ * (-cos 30 sin 20, cos 30 cos 20, sin 30)) and the offset n.(1, 2, 3) of its centre, every
+ * vertex within plane_eps of the plane and plane_eps at most 1e-4 of the quad's size; the
+ * box is not planar. */
+static void test_objects_planes(void)
+{
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"quad\", \"size\": [2, 3], \"material\": \"m\",\n"
+        "   \"transform\": {\"rotate\": [30, 0, 20], \"translate\": [1, 2, 3]}},\n"
+        "  {\"shape\": \"box\", \"size\": [1, 2, 3], \"material\": \"m\",\n"
+        "   \"transform\": {\"translate\": [-4, 0, 0]}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("planes.json", json, &s, &rec, &n)) return;
+    const Mesh *m = &s.mesh;
+    const SceneObject *q = &s.objects[0];
+    const VbObject *g = &rec[0];
+    const double a = 30 * PI_D / 180, c = 20 * PI_D / 180;
+    const double want[3] = {-cos(a) * sin(c), cos(a) * cos(c), sin(a)};
+    const double want_k = want[0] * 1 + want[1] * 2 + want[2] * 3;
+    double tn[3], tk, len = 0.0, dot = 0.0, dev = 0.0;
+    CHECK(tri_plane(m, q->first_tri, tn, &tk), "the quad's first triangle has a plane");
+    for (int k = 0; k < 3; k++) {
+        len += (double)g->plane[k] * g->plane[k];
+        dot += g->plane[k] * tn[k];
+    }
+    for (uint32_t t = q->first_tri; t < q->first_tri + q->ntris; t++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = corner(m, t, j);
+            dev = fmax(dev, fabs(g->plane[0] * v.x + g->plane[1] * v.y + g->plane[2] * v.z -
+                                 (double)g->plane[3]));
+        }
+    fprintf(stderr,
+            "    quad: n (%.7f %.7f %.7f), k %.7f (expected %.7f), plane_eps %.3g, largest "
+            "vertex distance %.3g\n",
+            g->plane[0], g->plane[1], g->plane[2], g->plane[3], want_k, g->plane_eps, dev);
+    CHECK(has(g, VBCL_OBJECT_PLANAR), "the quad is planar (flags %#x)", g->flags);
+    CHECK(fabs(sqrt(len) - 1.0) < 1e-6, "the plane's normal is a unit vector (%.9f)", sqrt(len));
+    CHECK(dot > 1.0 - 1e-6, "the normal is the triangles' (dot %.9f)", dot);
+    for (int k = 0; k < 3; k++)
+        CHECK(fabs(g->plane[k] - want[k]) < 1e-5, "normal[%d] %.7f, rotated +y %.7f", k,
+              g->plane[k], want[k]);
+    CHECK(fabs(g->plane[3] - want_k) < 1e-5 && fabs(g->plane[3] - tk) < 1e-5,
+          "offset %.7f: n.(1, 2, 3) is %.7f, the triangle's %.7f", g->plane[3], want_k, tk);
+    CHECK(dev <= g->plane_eps, "every vertex within plane_eps %.3g of the plane (%.3g)",
+          g->plane_eps, dev);
+    CHECK(g->plane_eps > 0.0f && g->plane_eps <= 1e-4 * 3.0, "plane_eps %.3g is small",
+          g->plane_eps);
+    CHECK(!has(&rec[1], VBCL_OBJECT_PLANAR), "the box is not planar (flags %#x)", rec[1].flags);
+    free(rec);
+    scene_free(&s);
+}
+
+/* ---- bounds ---- */
+
+/* Checks that the sphere sph (and record box's lo, hi, where box is not NULL) holds every
+ * vertex of triangles first .. first + n - 1 and of tf .. tf + tn - 1 and is tight: the
+ * radius at most 1e-4 of the size above half the diagonal of their exact box, the box within
+ * 1e-4 of the size of it. Returns the largest vertex distance from the sphere's centre. */
+static double check_holds(const Mesh *m, const char *what, const float sph[4], const VbObject *box,
+                          uint32_t first, uint32_t n, uint32_t tf, uint32_t tn)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    tri_box(m, first, n, lo, hi);
+    tri_box(m, tf, tn, lo, hi);
+    const double c[3] = {sph[0], sph[1], sph[2]};
+    double far = 0.0, diag = 0.0, mag = 0.0;
+    int out_box = 0;
+    for (uint32_t t = 0; t < n + tn; t++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = corner(m, t < n ? first + t : tf + (t - n), j);
+            far = fmax(far, dist3(c, v));
+            if (box)
+                out_box += v.x < box->lo[0] || v.y < box->lo[1] || v.z < box->lo[2] ||
+                           v.x > box->hi[0] || v.y > box->hi[1] || v.z > box->hi[2];
+        }
+    for (int a = 0; a < 3; a++) {
+        diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+        mag = fmax(mag, fmax(fabs(lo[a]), fabs(hi[a])));
+    }
+    double size = mag + 0.5 * sqrt(diag);
+    CHECK(far <= sph[3], "%s: a vertex %.9g from the centre, radius %.9g", what, far, sph[3]);
+    CHECK(sph[3] <= 0.5 * sqrt(diag) + 1e-4 * size, "%s: radius %.9g, half diagonal %.9g", what,
+          sph[3], 0.5 * sqrt(diag));
+    if (!box) return far;
+    CHECK(out_box == 0, "%s: %d vertices outside the box", what, out_box);
+    for (int a = 0; a < 3; a++)
+        CHECK(lo[a] - box->lo[a] <= 1e-4 * size && box->hi[a] - hi[a] <= 1e-4 * size,
+              "%s: box [%.9g, %.9g] along %d, the vertices' [%.9g, %.9g]", what, box->lo[a],
+              box->hi[a], a, lo[a], hi[a]);
+    return far;
+}
+
+/* A glass box [-1, 1]^3 whose texture holds an octahedron inside it and a box x in [1.5,
+ * 1.9] beside it (a texture may reach out of its host), and an opaque sphere without a
+ * texture: each record's bound sphere and box hold its own and its texture's vertices, and
+ * so do each part's; the own sphere holds the box's own vertices and leaves the far texture
+ * box out; the sphere's own sphere is its bound sphere. */
+static void test_objects_bounds(void)
+{
+    Obj tex = {0};
+    obj_octahedron(&tex, 0, 0, 0, 0.5);
+    obj_box(&tex, (const double[3]){1.5, -0.2, -0.2}, (const double[3]){1.9, 0.2, 0.2});
+    obj_write(&tex, "reach_tex.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"texture\": {\"file\": \"reach_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"sphere\", \"level\": 1, \"radius\": 0.5, \"centre\": [0, 3, 0], "
+        "\"material\": \"m\"}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("bounds.json", json, &s, &rec, &n)) return;
+    const Mesh *m = &s.mesh;
+    for (int i = 0; i < s.nobjects; i++) {
+        const SceneObject *o = &s.objects[i];
+        const VbObject *g = &rec[i];
+        char what[96];
+        snprintf(what, sizeof what, "%s bound", o->name);
+        double far = check_holds(m, what, g->bound, g, o->first_tri, o->ntris, o->first_tex_tri,
+                                 o->ntex_tris);
+        snprintf(what, sizeof what, "%s own", o->name);
+        double own = check_holds(m, what, g->own, NULL, o->first_tri, o->ntris, 0, 0);
+        fprintf(stderr, "    %s: bound radius %.7f (farthest vertex %.7f), own %.7f (%.7f)\n",
+                o->name, g->bound[3], far, g->own[3], own);
+        for (unsigned e = 0; e < g->nelems; e++) {
+            const VbObject *p = &rec[g->first_elem + e];
+            snprintf(what, sizeof what, "%s part %u", o->name, e);
+            check_holds(m, what, p->bound, p, p->first_tri, p->ntris, 0, 0);
+        }
+    }
+    /* the texture's far box, x = 1.9, reaches beyond the host's own sphere */
+    const double oc[3] = {rec[0].own[0], rec[0].own[1], rec[0].own[2]};
+    CHECK(dist3(oc, v3(1.9f, 0.2f, 0.2f)) > rec[0].own[3],
+          "the own sphere (radius %.7f) leaves out the texture reaching to x = 1.9", rec[0].own[3]);
+    CHECK(rec[0].nelems == 2, "the texture has two parts (%u)", rec[0].nelems);
+    CHECK(memcmp(rec[1].own, rec[1].bound, sizeof rec[1].own) == 0,
+          "without a texture the own sphere is the bound sphere");
+    free(rec);
+    scene_free(&s);
+}
+
+void suite_objects(void)
+{
+    RUN_TEST(test_objects_hulls);
+    RUN_TEST(test_objects_planes);
+    RUN_TEST(test_objects_bounds);
+}
