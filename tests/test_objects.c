@@ -1,6 +1,7 @@
 /* test_objects.c — the object analysis (host/compiled/objects.c) on small scenes, without an
- * OpenCL device: convexity and hulls, planes, bounds. Every expectation is computed here
- * from the scene's vertices, not taken from the records. */
+ * OpenCL device: convexity and hulls, planes, bounds, texture parts and the parts' ahead
+ * bits. Every expectation is computed here from the scene's vertices, not taken from the
+ * records. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -458,9 +459,218 @@ static void test_objects_bounds(void)
     scene_free(&s);
 }
 
+/* ---- texture parts ---- */
+
+/* The connected pieces of triangles first .. first + n - 1 (triangles that share a vertex
+ * index): label[t - first] is the least vertex index of triangle t's piece. */
+static void piece_labels(const Mesh *m, uint32_t first, uint32_t n, uint32_t *label)
+{
+    uint32_t *vl = malloc(sizeof *vl * (m->nverts ? m->nverts : 1));
+    if (!vl) {
+        memset(label, 0, sizeof *label * n);
+        return;
+    }
+    for (uint32_t v = 0; v < m->nverts; v++) vl[v] = v;
+    for (int changed = 1; changed;) { /* each triangle's corners take their least label */
+        changed = 0;
+        for (uint32_t t = first; t < first + n; t++) {
+            const uint32_t *c = &m->tris[3 * t];
+            uint32_t least = vl[c[0]] < vl[c[1]] ? vl[c[0]] : vl[c[1]];
+            least = least < vl[c[2]] ? least : vl[c[2]];
+            for (int j = 0; j < 3; j++) {
+                changed |= vl[c[j]] != least;
+                vl[c[j]] = least;
+            }
+        }
+    }
+    for (uint32_t t = 0; t < n; t++) label[t] = vl[m->tris[3 * (first + t)]];
+    free(vl);
+}
+
+/* Checks textured object i's part records against the runs of its texture's pieces (a new
+ * run wherever the next triangle is of another piece; none beyond
+ * VBCL_CONE_TEST_MAX_ELEMENTS runs); returns the number of runs. */
+static int check_parts(const Scene *s, const VbObject *rec, int i)
+{
+    const SceneObject *o = &s->objects[i];
+    const VbObject *g = &rec[i];
+    uint32_t *label = malloc(sizeof *label * (o->ntex_tris ? o->ntex_tris : 1));
+    if (!label) return -1;
+    piece_labels(&s->mesh, o->first_tex_tri, o->ntex_tris, label);
+    int runs = 0;
+    for (uint32_t t = 0; t < o->ntex_tris; t++) runs += t == 0 || label[t] != label[t - 1];
+    unsigned want = runs <= VBCL_CONE_TEST_MAX_ELEMENTS ? (unsigned)runs : 0u;
+    CHECK(g->nelems == want, "%s: %u parts, %d runs of pieces", o->name, g->nelems, runs);
+    uint32_t next = o->first_tex_tri; /* where the next part must start */
+    for (unsigned e = 0; e < g->nelems && e < want; e++) {
+        const VbObject *p = &rec[g->first_elem + e];
+        uint32_t a = p->first_tri - o->first_tex_tri, z = a + p->ntris; /* within the texture */
+        CHECK(p->host == (unsigned)i, "%s part %u: host %u", o->name, e, p->host);
+        CHECK(p->first_tri == next && p->ntris > 0 && z <= o->ntex_tris,
+              "%s part %u: triangles %u + %u, expected from %u within %u + %u", o->name, e,
+              p->first_tri, p->ntris, next, o->first_tex_tri, o->ntex_tris);
+        if (p->first_tri != next || p->ntris == 0 || z > o->ntex_tris) break;
+        for (uint32_t t = a + 1; t < z; t++)
+            CHECK(label[t] == label[a], "%s part %u: triangle %u of another piece", o->name, e,
+                  p->first_tri + (t - a));
+        CHECK(z == o->ntex_tris || label[z] != label[z - 1],
+              "%s part %u ends before a triangle of its own piece", o->name, e);
+        next = p->first_tri + p->ntris;
+    }
+    if (want > 0)
+        CHECK(next == o->first_tex_tri + o->ntex_tris, "%s: the parts cover the texture once",
+              o->name);
+    free(label);
+    return runs;
+}
+
+/* Four glass hosts and an opaque box: a box with a texture of 5 octahedra, a sphere with 4
+ * bombed spheres (`bomb --count 4 --no-overlap`), a box with two octahedra whose faces
+ * alternate in the file (16 runs), and a box with 65 octahedra (more than
+ * VBCL_CONE_TEST_MAX_ELEMENTS: bounded as a whole, no parts). Each part record belongs to
+ * its host and holds one run of one piece, the runs in order; the parts of a texture cover
+ * it exactly once; the records follow the scene's objects, texture after texture. */
+static void test_objects_texture_parts(void)
+{
+    Obj five = {0}, mixed = {0}, many = {0};
+    for (int k = 0; k < 5; k++) obj_octahedron(&five, -0.6 + 0.3 * k, 0, 0, 0.12);
+    int a = obj_octahedron_corners(&mixed, -0.4, 0, 0, 0.3),
+        b = obj_octahedron_corners(&mixed, 0.4, 0, 0, 0.3);
+    for (int f = 0; f < 8; f++) {
+        obj_octahedron_face(&mixed, a, f);
+        obj_octahedron_face(&mixed, b, f);
+    }
+    for (int k = 0; k < VBCL_CONE_TEST_MAX_ELEMENTS + 1; k++)
+        obj_octahedron(&many, -0.84 + 0.14 * (k % 13), -0.56 + 0.28 * (k / 13), 0, 0.05);
+    obj_write(&five, "five_tex.obj");
+    obj_write(&mixed, "mixed_tex.obj");
+    obj_write(&many, "many_tex.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [-6, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"five_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"sphere\", \"level\": 1, \"centre\": [-2, 0, 0], \"material\": \"glass\",\n"
+        "   \"texture\": {\"generate\": \"bomb --shape sphere --count 4 --size 10:16 --seed 5 "
+        "--level 1 --no-overlap\", \"material\": \"stone\"}},\n"
+        "  {\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [0, 4, 0]}},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [2, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"mixed_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [6, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"many_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("parts.json", json, &s, &rec, &n)) return;
+    const int want[5] = {5, 4, 0, 16, VBCL_CONE_TEST_MAX_ELEMENTS + 1};
+    unsigned next = (unsigned)s.nobjects; /* the next texture's first part record */
+    for (int i = 0; i < s.nobjects; i++) {
+        int runs = check_parts(&s, rec, i);
+        fprintf(stderr, "    %s: %u texture triangles, %d runs, %u part records from %u\n",
+                s.objects[i].name, s.objects[i].ntex_tris, runs, rec[i].nelems, rec[i].first_elem);
+        CHECK(runs == want[i], "%s: %d runs of pieces, expected %d", s.objects[i].name, runs,
+              want[i]);
+        if (rec[i].nelems == 0) continue;
+        CHECK(rec[i].first_elem == next, "%s: parts from record %u, expected %u", s.objects[i].name,
+              rec[i].first_elem, next);
+        next = rec[i].first_elem + rec[i].nelems;
+    }
+    CHECK(n == next, "%zu records: the objects and their parts (%u)", n, next);
+    CHECK(rec[4].nelems == 0, "a texture of %d pieces is bounded as a whole (%u parts)",
+          VBCL_CONE_TEST_MAX_ELEMENTS + 1, rec[4].nelems);
+    free(rec);
+    scene_free(&s);
+}
+
+/* ---- parts behind a host's planes ---- */
+
+/* Host i's part records' ahead bits, each against the test's own: bit j clear exactly where
+ * every vertex of the part lies behind the plane of the host's own triangle j by at least
+ * 1e-5 of the host's size (the margin). Returns the parts' masks in mask[] (at most 8). */
+static void check_ahead(const Scene *s, const VbObject *rec, int i, unsigned mask[8])
+{
+    const SceneObject *o = &s->objects[i];
+    const VbObject *g = &rec[i];
+    double margin = 1e-5 * object_size(&s->mesh, o);
+    for (unsigned e = 0; e < g->nelems && e < 8; e++) {
+        const VbObject *p = &rec[g->first_elem + e];
+        unsigned want = ~0u;
+        for (uint32_t j = 0; j < o->ntris && j < VBCL_AHEAD_BITS; j++) {
+            double h = max_height_one(&s->mesh, o->first_tri + j, p->first_tri, p->ntris);
+            if (h <= -margin) want &= ~(1u << j);
+        }
+        fprintf(stderr, "    %s part %u: ahead %#x, expected %#x\n", o->name, e, p->ahead, want);
+        CHECK(p->ahead == want, "%s part %u: ahead %#x, expected %#x (margin %.3g)", o->name, e,
+              p->ahead, want, margin);
+        mask[e] = want;
+    }
+}
+
+/* The own triangles of object o whose unit normal is `sign` along axis `axis` (a face of a
+ * box), as a mask of ahead bits. */
+static unsigned face_bits(const Mesh *m, const SceneObject *o, int axis, double sign)
+{
+    unsigned bits = 0;
+    for (uint32_t j = 0; j < o->ntris; j++) {
+        double n[3], k;
+        if (tri_plane(m, o->first_tri + j, n, &k) && fabs(n[axis] - sign) < 1e-9) bits |= 1u << j;
+    }
+    return bits;
+}
+
+/* A glass box [-1, 1]^3 (12 own triangles: a hull) with four parts: an octahedron at the
+ * centre, behind every face by 0.5 or more; a box behind every face but reaching to
+ * y = 1 - 2e-6, within the margin (about 3e-5) of the +y face; a box crossing the +x face;
+ * and a box 1e-3 behind the -z face. The ahead bits are clear exactly where the part lies
+ * behind the face triangle's plane by the margin: the first and last parts 0, the second
+ * only the +y face's two triangles set, the third only the +x face's. */
+static void test_objects_parts_ahead(void)
+{
+    Obj tex = {0};
+    obj_octahedron(&tex, 0, 0, 0, 0.3);
+    obj_box(&tex, (const double[3]){0.2, 0.5, -0.2}, (const double[3]){0.6, 1 - 2e-6, 0.2});
+    obj_box(&tex, (const double[3]){0.8, -0.5, -0.2}, (const double[3]){1.3, -0.2, 0.2});
+    obj_box(&tex, (const double[3]){-0.6, -0.6, -1 + 1e-3}, (const double[3]){-0.3, -0.3, -0.5});
+    obj_write(&tex, "ahead_tex.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"texture\": {\"file\": \"ahead_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("ahead.json", json, &s, &rec, &n)) return;
+    unsigned mask[8] = {0};
+    CHECK(has(&rec[0], VBCL_OBJECT_HULL) && rec[0].nelems == 4,
+          "the box is a hull with four parts (flags %#x, %u parts)", rec[0].flags, rec[0].nelems);
+    if (rec[0].nelems == 4) {
+        check_ahead(&s, rec, 0, mask);
+        unsigned top = face_bits(&s.mesh, &s.objects[0], 1, 1.0),
+                 side = face_bits(&s.mesh, &s.objects[0], 0, 1.0);
+        unsigned own = (1u << s.objects[0].ntris) - 1; /* the bits of its triangles */
+        /* the fixture: what the rule must say of these four */
+        CHECK((mask[0] & own) == 0 && (mask[3] & own) == 0,
+              "the inner parts lie behind every face");
+        CHECK(top != 0 && (mask[1] & own) == top, "the part near +y: %#x, the +y face's bits %#x",
+              mask[1] & own, top);
+        CHECK(side != 0 && (mask[2] & own) == side,
+              "the part through +x: %#x, the +x face's bits %#x", mask[2] & own, side);
+    }
+    free(rec);
+    scene_free(&s);
+}
+
 void suite_objects(void)
 {
     RUN_TEST(test_objects_hulls);
     RUN_TEST(test_objects_planes);
     RUN_TEST(test_objects_bounds);
+    RUN_TEST(test_objects_texture_parts);
+    RUN_TEST(test_objects_parts_ahead);
 }
