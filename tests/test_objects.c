@@ -1,7 +1,7 @@
 /* test_objects.c — the object analysis (host/compiled/objects.c) on small scenes, without an
- * OpenCL device: convexity and hulls, planes, bounds, texture parts and the parts' ahead
- * bits. Every expectation is computed here from the scene's vertices, not taken from the
- * records. */
+ * OpenCL device: convexity and hulls, planes, bounds, texture parts, the parts' ahead bits,
+ * solid parts' cores and hosts' inner spheres. Every expectation is computed here from the
+ * scene's vertices, not taken from the records. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -666,6 +666,258 @@ static void test_objects_parts_ahead(void)
     scene_free(&s);
 }
 
+/* ---- solid parts, cores and inner spheres ---- */
+
+/* How far the point c lies behind the nearest plane of triangles first .. first + n - 1
+ * (negative: ahead of one of them). */
+static double min_depth(const Mesh *m, uint32_t first, uint32_t n, const double c[3])
+{
+    double least = INFINITY, nrm[3], k;
+    for (uint32_t t = first; t < first + n; t++) {
+        if (!tri_plane(m, t, nrm, &k)) return -INFINITY;
+        least = fmin(least, -height(nrm, k, c[0], c[1], c[2]));
+    }
+    return least;
+}
+
+/* The mean of the corners of triangles first .. first + n - 1. */
+static void corner_mean(const Mesh *m, uint32_t first, uint32_t n, double c[3])
+{
+    c[0] = c[1] = c[2] = 0.0;
+    for (uint32_t t = first; t < first + n; t++)
+        for (int j = 0; j < 3; j++) {
+            vec3 v = corner(m, t, j);
+            c[0] += v.x / (3.0 * n);
+            c[1] += v.y / (3.0 * n);
+            c[2] += v.z / (3.0 * n);
+        }
+}
+
+/* Whether every directed edge a -> b of triangles first .. first + n - 1 has its reverse
+ * among them (a closed surface, by vertex indices). */
+static int closed_by_edges(const Mesh *m, uint32_t first, uint32_t n)
+{
+    for (uint32_t t = first; t < first + n; t++)
+        for (int j = 0; j < 3; j++) {
+            uint32_t a = m->tris[3 * t + j], b = m->tris[3 * t + (j + 1) % 3];
+            int found = 0;
+            for (uint32_t u = first; u < first + n && !found; u++)
+                for (int i = 0; i < 3 && !found; i++)
+                    found = m->tris[3 * u + i] == b && m->tris[3 * u + (i + 1) % 3] == a;
+            if (!found) return 0;
+        }
+    return 1;
+}
+
+/* Checks the sphere `core` (a record's VbObject.inside) against triangles first .. first +
+ * n - 1 and, where hn > 0, a host's hf .. hf + hn - 1: behind every plane of both, and as
+ * large as the lesser depth of c (the expected centre) behind them, less 1%. */
+static void check_core(const Mesh *m, const char *what, const float core[4], const double c[3],
+                       uint32_t first, uint32_t n, uint32_t hf, uint32_t hn)
+{
+    const double at[3] = {core[0], core[1], core[2]};
+    double in_part = min_depth(m, first, n, at), in_host = hn ? min_depth(m, hf, hn, at) : INFINITY;
+    double room = fmin(min_depth(m, first, n, c), hn ? min_depth(m, hf, hn, c) : INFINITY);
+    fprintf(stderr,
+            "    %s: sphere (%.5f %.5f %.5f) radius %.6f; its centre %.6f behind its planes", what,
+            core[0], core[1], core[2], core[3], in_part);
+    if (hn) fprintf(stderr, ", %.6f behind the host's", in_host);
+    fprintf(stderr, "; room %.6f\n", room);
+    CHECK(core[3] > 0.0f && core[3] <= in_part,
+          "%s: the sphere (radius %.6f) lies behind every plane of its own (%.6f)", what, core[3],
+          in_part);
+    CHECK(core[3] <= in_host, "%s: the sphere (radius %.6f) lies inside the host (%.6f)", what,
+          core[3], in_host);
+    CHECK(core[3] >= 0.99 * room, "%s: the sphere (radius %.6f) fills the room about c (%.6f)",
+          what, core[3], room);
+    for (int a = 0; a < 3; a++)
+        CHECK(fabs(core[a] - c[a]) < 1e-5, "%s: centre[%d] %.7f, expected %.7f", what, a, core[a],
+              c[a]);
+}
+
+/* Whether part p of textured host o may be solid by the test's own reckoning: o's own
+ * triangles convex, the texture material opaque and no object's own, the part convex,
+ * closed, not planar, and the mean of its corners well inside it and inside o. */
+static int solid_expected(const Scene *s, const SceneObject *o, const VbObject *p)
+{
+    const Mesh *m = &s->mesh;
+    double eps = 1e-6 * object_size(m, o), c[3];
+    int ok = max_height(m, o->first_tri, o->ntris, o->first_tri, o->ntris) <= eps &&
+             !(s->materials[o->tex_material].gpu.k_global > 0.0f);
+    for (int j = 0; j < s->nobjects; j++) ok &= s->objects[j].material != o->tex_material;
+    corner_mean(m, p->first_tri, p->ntris, c);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    tri_box(m, p->first_tri, p->ntris, lo, hi);
+    int flat = hi[0] - lo[0] < eps || hi[1] - lo[1] < eps || hi[2] - lo[2] < eps;
+    return ok && !flat && max_height(m, p->first_tri, p->ntris, p->first_tri, p->ntris) <= eps &&
+           closed_by_edges(m, p->first_tri, p->ntris) &&
+           min_depth(m, p->first_tri, p->ntris, c) > 100 * eps &&
+           min_depth(m, o->first_tri, o->ntris, c) > 100 * eps;
+}
+
+/* Checks the parts of textured object i: VBCL_OBJECT_SOLID where solid_expected says, with a
+ * core (check_core) inside the part and inside the host; returns the parts found solid as
+ * bits. */
+static unsigned check_solid_parts(const Scene *s, const VbObject *rec, int i)
+{
+    const SceneObject *o = &s->objects[i];
+    unsigned solid = 0;
+    for (unsigned e = 0; e < rec[i].nelems && e < 32; e++) {
+        const VbObject *p = &rec[rec[i].first_elem + e];
+        int want = solid_expected(s, o, p);
+        CHECK(has(p, VBCL_OBJECT_SOLID) == want, "%s part %u: SOLID %d, expected %d", o->name, e,
+              has(p, VBCL_OBJECT_SOLID), want);
+        if (!has(p, VBCL_OBJECT_SOLID)) continue;
+        solid |= 1u << e;
+        char what[96];
+        double c[3];
+        snprintf(what, sizeof what, "%s part %u", o->name, e);
+        corner_mean(&s->mesh, p->first_tri, p->ntris, c);
+        check_core(&s->mesh, what, p->inside, c, p->first_tri, p->ntris, o->first_tri, o->ntris);
+    }
+    return solid;
+}
+
+/* Solid parts: a glass box whose opaque texture (a material no object has) holds an
+ * octahedron inside it, an octahedron reaching out through its +y face (its core shrunk to
+ * lie inside the box), an L-shaped prism (not convex) and a box; the same texture in a glass
+ * box with a transparent texture material, and in one whose texture material is an object's
+ * own; an opaque sphere of 80 triangles, an opaque box of 12 and an opaque
+ * hourglass. SOLID exactly where the rules say (the octahedra and the box part; the sphere),
+ * each core behind every plane of its part (and host), centred on the mean of the corners and
+ * at least 0.99 of the room there. */
+static void test_objects_solid_parts(void)
+{
+    Obj tex = {0};
+    obj_octahedron(&tex, -0.4, -0.3, 0, 0.4);
+    obj_octahedron(&tex, 0, 0.8, 0, 0.5);
+    obj_ell(&tex, 0.2, -0.9, 0, 0.3);
+    obj_box(&tex, (const double[3]){0.4, -0.1, -0.3}, (const double[3]){0.8, 0.2, 0.3});
+    obj_write(&tex, "solid_tex.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"texture\": {\"file\": \"solid_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [4, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"solid_tex.obj\", \"material\": \"clear\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [-4, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"solid_tex.obj\", \"material\": \"m\", " IDENTITY_BLOCK "}},\n"
+        "  {\"shape\": \"sphere\", \"level\": 1, \"centre\": [0, 4, 0], \"material\": \"m\"},\n"
+        "  {\"shape\": \"box\", \"material\": \"m\", \"transform\": {\"translate\": [4, 4, 0]}},\n"
+        "  {\"shape\": \"revolution\", \"segments\": 12, \"material\": \"m\",\n"
+        "   \"profile\": [[0.6, 0], [0.2, 0.5], [0.6, 1]], \"transform\": {\"translate\": [0, -5, "
+        "0]}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("solid.json", json, &s, &rec, &n)) return;
+    unsigned solid[3];
+    for (int i = 0; i < 3; i++) solid[i] = check_solid_parts(&s, rec, i);
+    CHECK(rec[0].nelems == 4 && solid[0] == 0xb, "the two octahedra and the box are solid (%#x)",
+          solid[0]);
+    CHECK(solid[1] == 0 && solid[2] == 0,
+          "no part of a transparent texture (%#x) nor of an object's material (%#x) is solid",
+          solid[1], solid[2]);
+    CHECK(has(&rec[rec[1].first_elem], VBCL_OBJECT_CONVEX),
+          "the transparent texture's octahedron is convex all the same");
+    for (int i = 3; i < s.nobjects; i++) {
+        const SceneObject *o = &s.objects[i];
+        double eps = 1e-6 * object_size(&s.mesh, o), c[3];
+        int convex = max_height(&s.mesh, o->first_tri, o->ntris, o->first_tri, o->ntris) <= eps;
+        int want = convex && o->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2;
+        CHECK(has(&rec[i], VBCL_OBJECT_SOLID) == want, "%s (%u triangles): SOLID %d, expected %d",
+              o->name, o->ntris, has(&rec[i], VBCL_OBJECT_SOLID), want);
+        if (!has(&rec[i], VBCL_OBJECT_SOLID)) continue;
+        corner_mean(&s.mesh, o->first_tri, o->ntris, c);
+        check_core(&s.mesh, o->name, rec[i].inside, c, o->first_tri, o->ntris, 0, 0);
+    }
+    CHECK(has(&rec[3], VBCL_OBJECT_SOLID) && !has(&rec[4], VBCL_OBJECT_SOLID) &&
+              !has(&rec[5], VBCL_OBJECT_SOLID),
+          "the sphere is solid, the small box and the hourglass not");
+    free(rec);
+    scene_free(&s);
+}
+
+/* Checks record i's inner sphere: VBCL_OBJECT_INNER exactly on a host of more than
+ * VBCL_OBJECT_SET_MAX_TRIS / 2 own triangles that are convex, its sphere behind every plane of
+ * them, centred on the middle of their box and filling at least 0.99 of the room there. */
+static void check_inner(const Scene *s, const VbObject *rec, int i)
+{
+    const SceneObject *o = &s->objects[i];
+    const Mesh *m = &s->mesh;
+    double eps = 1e-6 * object_size(m, o), c[3];
+    int want = o->is_host && o->ntris > VBCL_OBJECT_SET_MAX_TRIS / 2 &&
+               max_height(m, o->first_tri, o->ntris, o->first_tri, o->ntris) <= eps;
+    CHECK(has(&rec[i], VBCL_OBJECT_INNER) == want, "%s (%u triangles): INNER %d, expected %d",
+          o->name, o->ntris, has(&rec[i], VBCL_OBJECT_INNER), want);
+    if (!has(&rec[i], VBCL_OBJECT_INNER)) return;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    tri_box(m, o->first_tri, o->ntris, lo, hi);
+    for (int a = 0; a < 3; a++) c[a] = 0.5 * (lo[a] + hi[a]);
+    check_core(m, o->name, rec[i].inside, c, o->first_tri, o->ntris, 0, 0);
+}
+
+/* Inner spheres: a glass sphere of 320 triangles whose texture holds an octahedron at its
+ * centre and one reaching out of it at x = 0.9, a glass sphere of 80 triangles without a
+ * texture, and a glass box with the same texture (a hull of 12 triangles: too few). INNER on
+ * both spheres, their inner spheres behind every own plane, about their own triangles'
+ * centre (the texture reaching out moves the bound sphere, not this), at least 0.99 of the
+ * room there; the box none. The big host's parts (320 own triangles, more than
+ * VBCL_AHEAD_BITS): ahead 0 for the part within 0.9 of the inner sphere's radius, every bit
+ * for the one reaching beyond it. */
+static void test_objects_inner_spheres(void)
+{
+    Obj tex = {0};
+    obj_octahedron(&tex, 0, 0, 0, 0.2);
+    obj_octahedron(&tex, 0.9, 0, 0, 0.3);
+    obj_write(&tex, "inner_tex.obj");
+    const char *json = OBJECTS_SCENE_HEAD
+        " \"objects\": [\n"
+        "  {\"shape\": \"sphere\", \"level\": 2, \"material\": \"glass\",\n"
+        "   \"texture\": {\"file\": \"inner_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}},\n"
+        "  {\"shape\": \"sphere\", \"level\": 1, \"centre\": [-4, 0, 0], \"material\": "
+        "\"glass\"},\n"
+        "  {\"shape\": \"box\", \"size\": [2, 2, 2], \"material\": \"glass\",\n"
+        "   \"transform\": {\"translate\": [4, 0, 0]},\n"
+        "   \"texture\": {\"file\": \"inner_tex.obj\", \"material\": \"stone\", " IDENTITY_BLOCK
+        "}}]}";
+    Scene s;
+    VbObject *rec;
+    size_t n;
+    if (load_objects("inner.json", json, &s, &rec, &n)) return;
+    for (int i = 0; i < s.nobjects; i++) check_inner(&s, rec, i);
+    CHECK(has(&rec[0], VBCL_OBJECT_INNER) && has(&rec[1], VBCL_OBJECT_INNER) &&
+              !has(&rec[2], VBCL_OBJECT_INNER),
+          "both spheres have inner spheres, the box none");
+    CHECK(rec[0].nelems == 2, "the big sphere's texture has two parts (%u)", rec[0].nelems);
+    CHECK(rec[0].bound[0] > 0.05f, "the texture reaching out moves the bound sphere (x %.4f)",
+          rec[0].bound[0]);
+    const double ic[3] = {rec[0].inside[0], rec[0].inside[1], rec[0].inside[2]};
+    for (unsigned e = 0; e < rec[0].nelems && has(&rec[0], VBCL_OBJECT_INNER); e++) {
+        const VbObject *p = &rec[rec[0].first_elem + e];
+        double far = 0.0;
+        for (uint32_t t = p->first_tri; t < p->first_tri + p->ntris; t++)
+            for (int j = 0; j < 3; j++) far = fmax(far, dist3(ic, corner(&s.mesh, t, j)));
+        unsigned want = far <= 0.9 * rec[0].inside[3] ? 0u : ~0u;
+        fprintf(stderr,
+                "    part %u: reaches %.4f from the inner sphere's centre (radius %.4f), "
+                "ahead %#x\n",
+                e, far, rec[0].inside[3], p->ahead);
+        CHECK(far <= 0.9 * rec[0].inside[3] || far > rec[0].inside[3],
+              "the fixture: part %u is well within the inner sphere or beyond it", e);
+        CHECK(p->ahead == want, "part %u: ahead %#x, expected %#x", e, p->ahead, want);
+    }
+    CHECK(rec[0].nelems < 2 || rec[rec[0].first_elem].ahead != rec[rec[0].first_elem + 1].ahead,
+          "one part within the inner sphere, one beyond it");
+    free(rec);
+    scene_free(&s);
+}
+
 void suite_objects(void)
 {
     RUN_TEST(test_objects_hulls);
@@ -673,4 +925,6 @@ void suite_objects(void)
     RUN_TEST(test_objects_bounds);
     RUN_TEST(test_objects_texture_parts);
     RUN_TEST(test_objects_parts_ahead);
+    RUN_TEST(test_objects_solid_parts);
+    RUN_TEST(test_objects_inner_spheres);
 }
