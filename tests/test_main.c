@@ -130,6 +130,7 @@ int main(int argc, char **argv)
     suite_mesh();
     suite_grid_build();
     suite_scene();
+    suite_objects();
     suite_texgen();
     suite_cli();
     suite_optics();

@@ -34,6 +34,7 @@ int tu_dir_has(const char *dir, const char *part);
 void suite_mesh(void);
 void suite_grid_build(void);
 void suite_scene(void);
+void suite_objects(void);
 void suite_texgen(void);
 void suite_cli(void);
 void suite_kernels(void);
