@@ -173,6 +173,8 @@ static const StatsField stats_fields[] = {
     {FIELD("grid", "cells", GR(ncells), " = %lld cells")},
     {FIELD("grid", "auto", DR(grid_auto), " (%s)"), .text_at = DR(grid_how)},
     {FIELD("grid", "build_ms", RS(grid_ms), ", build %.1f ms")},
+    {JSON("compile", "scenes", RS(scene_compiles))},
+    {JSON("compile", "geometry_built", RS(geometry_builds))},
     {JSON("grid", "triangle_refs", GR(nrefs))},
     {FIELD("grid", "tris_per_cell_mean", GR(tris_per_cell_mean), ", triangles per cell mean %.2f")},
     {FIELD("grid", "tris_per_cell_max", GR(tris_per_cell_max), " max %lld")},

@@ -509,6 +509,47 @@ static void expect_bad(const char *scene_text, const char *extra_args, const cha
           "existing output untouched");
 }
 
+/* An animation that moves its quad out of the view: the geometry of each frame is built
+ * anew (compile.geometry_built 1) and the moved quad is seen where it is, not where the
+ * last frame's geometry had it. */
+static void frames_moving_quad(void)
+{
+    const char *scene = tu_write_file(
+        "anim_move.json",
+        "{\"image\": {\"width\": 8, \"height\": 8, \"background\": [0, 0, 0]},"
+        " \"camera\": {\"eye\": [0, 0, 5], \"look_at\": [0, 0, 0]},"
+        " \"render\": {\"ambient\": [1, 1, 1]},"
+        " \"materials\": {\"m\": {\"ambient\": [0.5, 0.5, 0.5], \"diffuse\": [0, 0, 0]}},"
+        " \"objects\": [{\"shape\": \"quad\", \"size\": [20, 20], \"material\": \"m\","
+        "   \"transform\": {\"rotate\": [90, 0, 0], \"translate\": [0, 0, 0]}}],"
+        " \"animation\": {\"frames\": 2, \"tracks\": [{\"target\":"
+        " \"objects.0.transform.translate\", \"keys\": [[0, [0, 0, 0]], [1, [100, 0, 0]]]}]}}");
+    char out[8192], args[2048], json[512], path[512], err[512];
+    snprintf(json, sizeof json, "%s/anim_move.json.stats", tu_tmpdir());
+    snprintf(args, sizeof args, "%s -o %s/move_#.exr --stats-json %s", scene, tu_tmpdir(), json);
+    int rc = vbcl(args, out, sizeof out);
+    CHECK(rc == 0, "moving quad: exit %d: %s", rc, out);
+    cJSON *doc = read_json(json);
+    const cJSON *frames = cJSON_GetObjectItemCaseSensitive(doc, "frames");
+    for (int k = 0; k < 2; k++)
+        CHECK(json_num(cJSON_GetArrayItem(frames, k), "compile", "geometry_built", NULL) == 1,
+              "moving quad: frame %d builds its geometry", k);
+    cJSON_Delete(doc);
+    for (int f = 0; f < 2; f++) {
+        float *px = NULL;
+        int w, h;
+        snprintf(path, sizeof path, "%s/move_%d.exr", tu_tmpdir(), f);
+        if (image_read(path, &w, &h, &px, err, sizeof err)) {
+            CHECK(0, "%s", err);
+            continue;
+        }
+        double want = f == 0 ? 0.5 : 0.0; /* the quad, then the background */
+        CHECK(fabs(px[4 * (4 * w + 4)] - want) < 1e-5, "moving quad: frame %d centre %g, want %g",
+              f, px[4 * (4 * w + 4)], want);
+        free(px);
+    }
+}
+
 /* --frames renders numbered frames of an animated scene: a run of # in -o becomes the frame
  * number; the frames differ as the animation says. */
 static void test_cli_frames(void)
@@ -539,11 +580,17 @@ static void test_cli_frames(void)
     const cJSON *frames = cJSON_GetObjectItemCaseSensitive(doc, "frames");
     CHECK(cJSON_GetArraySize(frames) == 2 && json_num(doc, "frames_in_scene", NULL) == 3,
           "--stats-json of frames 1:2 has two frames of 3");
-    for (int k = 0; k < cJSON_GetArraySize(frames); k++)
-        CHECK(json_num(cJSON_GetArrayItem(frames, k), "frame", NULL) == 1 + k &&
-                  json_num(cJSON_GetArrayItem(frames, k), "rays", "primary", NULL) == 64,
+    for (int k = 0; k < cJSON_GetArraySize(frames); k++) {
+        const cJSON *fk = cJSON_GetArrayItem(frames, k);
+        CHECK(json_num(fk, "frame", NULL) == 1 + k && json_num(fk, "rays", "primary", NULL) == 64,
               "frames[%d] is frame %d with 64 primary rays", k, 1 + k);
+        /* only a material changes: the second frame keeps the first's geometry */
+        CHECK(json_num(fk, "compile", "scenes", NULL) == 1 &&
+                  json_num(fk, "compile", "geometry_built", NULL) == (k == 0),
+              "frames[%d]: one compile, geometry %s", k, k == 0 ? "built" : "kept");
+    }
     cJSON_Delete(doc);
+    frames_moving_quad();
     for (int f = 0; f < 3; f++) {
         snprintf(path, sizeof path, "%s/frame_%03d.exr", tu_tmpdir(), f);
         CHECK(file_exists(path) == (f >= 1), "frame %d %s", f, f >= 1 ? "missing" : "written");
