@@ -2,6 +2,8 @@
  * image, report. Only this file exits. */
 #include <errno.h>
 #include <limits.h>
+#include <pthread.h>
+#include <sys/resource.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -924,8 +926,49 @@ static int run(Dist *d, int argc, char **argv, double t0)
     return rc;
 }
 
+/* The stack vbcl runs with: a kernel's work-group function keeps every work item's private
+ * arrays (a ray tree's stack) on the stack of PoCL's thread, which glibc sizes by the stack
+ * limit (ulimit -s), so a limit of 256 KiB overflows it (SIGSEGV), and at 96 KiB the main
+ * thread overflows too. */
+#define STACK_WANT ((rlim_t)8 << 20)
+#define STACK_MIN  ((rlim_t)128 << 10) /* the main thread's need, with a margin */
+
+/* Below STACK_WANT: gives the threads created from here on STACK_WANT, and raises the stack
+ * limit toward it (up to the hard limit) and runs vbcl again under it (the main thread's
+ * stack is sized when a program starts). Returns 0, or 1 after a message where the hard
+ * limit is below STACK_MIN. */
+static int stack_limit(char **argv)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_STACK, &rl) || rl.rlim_cur == RLIM_INFINITY || rl.rlim_cur >= STACK_WANT)
+        return 0;
+    pthread_attr_t a;
+    if (!pthread_attr_init(&a)) {
+        if (!pthread_attr_setstacksize(&a, (size_t)STACK_WANT)) pthread_setattr_default_np(&a);
+        pthread_attr_destroy(&a);
+    }
+    if (getenv("VBCL_STACK_RAISED")) return 0; /* raised as far as it goes already */
+    rlim_t want =
+        rl.rlim_max == RLIM_INFINITY || rl.rlim_max > STACK_WANT ? STACK_WANT : rl.rlim_max;
+    if (want < STACK_MIN) {
+        fprintf(stderr,
+                "%s: the stack limit (ulimit -s) is %llu KiB and cannot be raised above %llu "
+                "KiB; vbcl needs %llu KiB or more (ulimit -s %llu)\n",
+                prog, (unsigned long long)rl.rlim_cur / 1024,
+                (unsigned long long)rl.rlim_max / 1024, (unsigned long long)STACK_MIN / 1024,
+                (unsigned long long)STACK_WANT / 1024);
+        return 1;
+    }
+    if (want <= rl.rlim_cur) return 0; /* as far as it goes: the threads' stacks suffice */
+    rl.rlim_cur = want;
+    if (setrlimit(RLIMIT_STACK, &rl) || setenv("VBCL_STACK_RAISED", "1", 1)) return 0;
+    execv("/proc/self/exe", argv);
+    return 0; /* not run again: go on with the threads' stacks raised */
+}
+
 int main(int argc, char **argv)
 {
+    if (stack_limit(argv)) return 1;
     /* A file-size limit (ulimit -f) then fails the write with "File too large", which
      * fileio.c reports with the file's name, instead of killing the process mid-write. */
     signal(SIGXFSZ, SIG_IGN);

@@ -108,6 +108,73 @@ static void test_faults_file_size_limit(void)
     }
 }
 
+/* A memory limit (ulimit -v, 1.1 GiB) that the render of a 512 x 512 image leaves room in,
+ * but not anti-aliasing's trees for every pixel (--aa-min-level 1: 1.4 GiB): exit 1 with one
+ * line naming what ran out and what would take less, the older image whole (before: PoCL
+ * failed an assertion at the buffer's first use, SIGABRT). */
+static void test_faults_memory_limit(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+#ifdef __SANITIZE_ADDRESS__
+    th_skip("AddressSanitizer's shadow memory alone is beyond any such limit");
+    return;
+#endif
+    const char *dir = fault_dir("vmem");
+    char args[2048], cmd[4096], out[4096], path[1024];
+    snprintf(path, sizeof path, "%s/out.png", dir);
+    snprintf(args, sizeof args,
+             "tests/scenes/aa_edges.json -q --width 512 --height 512 --aa 0.1 -o %s", path);
+    snprintf(cmd, sizeof cmd, "bash -c 'ulimit -v 1200000; exec %s %s'", tu_vbcl, args);
+    CHECK(tu_run(cmd, out, sizeof out) == 0, "the render alone fits the limit: %s", out);
+    put_old(path);
+    snprintf(cmd, sizeof cmd, "bash -c 'ulimit -v 1200000; exec %s %s --aa-min-level 1'", tu_vbcl,
+             args);
+    int rc = tu_run(cmd, out, sizeof out);
+    char *nl = strchr(out, '\n');
+    CHECK(rc == 1 && strstr(out, "out of memory for anti-aliasing's trees") &&
+              strstr(out, "--aa-min-level") && nl && nl[1] == 0,
+          "trees over the memory limit: exit 1, one line naming them and what takes less (%d): %s",
+          rc, out);
+    CHECK(old_intact(path), "the older image is intact");
+    CHECK(!tu_dir_has(dir, ".tmp"), "no temporary left");
+}
+
+/* A small stack limit (ulimit -s): 256 KiB overflowed PoCL's threads, which glibc sizes by
+ * it, in a kernel's work-group function (SIGSEGV): vbcl now gives its threads 8 MiB and
+ * renders; a soft limit of 64 KiB under an unlimited hard one is raised (vbcl runs itself
+ * again); a hard limit of 96 KiB, too small for its main thread, is a message and exit 1. */
+static void test_faults_small_stack(void)
+{
+    if (!tu_device()) {
+        th_skip("no OpenCL device");
+        return;
+    }
+#ifdef __SANITIZE_ADDRESS__
+    th_skip("AddressSanitizer's own stack use differs");
+    return;
+#endif
+    const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
+    const char *dir = fault_dir("stack");
+    char cmd[4096], out[4096], path[1024];
+    snprintf(path, sizeof path, "%s/out.pfm", dir);
+    static const char *const limits[] = {"ulimit -s 256", "ulimit -S -s 64", "ulimit -s 96"};
+    for (int k = 0; k < 3; k++) {
+        put_old(path);
+        snprintf(cmd, sizeof cmd, "bash -c '%s; exec %s %s -q --width 96 --height 96 -o %s'",
+                 limits[k], tu_vbcl, scene, path);
+        int rc = tu_run(cmd, out, sizeof out);
+        if (k < 2)
+            CHECK(rc == 0 && !old_intact(path), "%s: renders (%d): %s", limits[k], rc, out);
+        else
+            CHECK(rc == 1 && strstr(out, "stack limit (ulimit -s) is 96 KiB") && old_intact(path),
+                  "%s: exit 1 naming the limit, the older image whole (%d): %s", limits[k], rc,
+                  out);
+    }
+}
+
 /* A full disk: a 64 KiB tmpfs (where this machine lets the tests mount one), holding an
  * old file. Every image format fails with ENOSPC, exit 1, the old file whole. */
 static void test_faults_full_disk(void)
@@ -136,6 +203,19 @@ static void test_faults_full_disk(void)
               "%s on a full disk: exit 1 naming the file and the cause (%d): %s", ext, rc, out);
         CHECK(old_intact(path), "%s: the older file is intact", ext);
         CHECK(!tu_dir_has(dir, ".tmp"), "%s: no temporary left", ext);
+    }
+    /* PoCL's kernel cache on the full disk: the build fails, and vbcl says why in one line
+     * (before: "kernel build failed", an empty build log and CL_BUILD_PROGRAM_FAILURE) */
+    if (tu_device() && strstr(tu_device()->name, "Portable Computing Language")) {
+        snprintf(path, sizeof path, "%s/../cache-full.pfm", dir);
+        snprintf(cmd, sizeof cmd, "POCL_CACHE_DIR='%s' %s %s -q --width 16 --height 16 -o %s", dir,
+                 tu_vbcl, scene, path);
+        int rc = tu_run(cmd, out, sizeof out);
+        char *nl = strchr(out, '\n');
+        CHECK(rc == 1 && strstr(out, "PoCL cannot write its kernel cache") && strstr(out, dir) &&
+                  strstr(out, "No space left on device") && nl && nl[1] == 0,
+              "PoCL's cache on a full disk: exit 1, one line naming it and the cause (%d): %s", rc,
+              out);
     }
     snprintf(cmd, sizeof cmd, "umount '%s'", dir);
     tu_run(cmd, NULL, 0);
@@ -395,6 +475,8 @@ static void test_faults_unbounded_tree(void)
 void suite_faults(void)
 {
     RUN_TEST(test_faults_file_size_limit);
+    RUN_TEST(test_faults_memory_limit);
+    RUN_TEST(test_faults_small_stack);
     RUN_TEST(test_faults_full_disk);
     RUN_TEST(test_faults_sync_fails);
     RUN_TEST(test_faults_signal_in_write);

@@ -345,6 +345,12 @@ int clu_device_open_index(int index, VbDevice *d, char *err, size_t errlen)
     clGetDeviceInfo(d->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof d->max_alloc, &d->max_alloc,
                     NULL);
     clGetDeviceInfo(d->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof d->max_wg, &d->max_wg, NULL);
+    cl_device_type type = 0;
+    cl_uint align_bits = 0;
+    clGetDeviceInfo(d->device, CL_DEVICE_TYPE, sizeof type, &type, NULL);
+    clGetDeviceInfo(d->device, CL_DEVICE_MEM_BASE_ADDR_ALIGN, sizeof align_bits, &align_bits, NULL);
+    d->host_memory = (type & CL_DEVICE_TYPE_CPU) != 0;
+    d->host_align = align_bits / 8 > 128 ? align_bits / 8 : 128;
     cl_int rc;
     cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)d->platform, 0};
     d->context = clCreateContext(props, 1, &d->device, NULL, NULL, &rc);
@@ -501,6 +507,38 @@ static int driver_is_pocl(const VbDevice *d)
     return strstr(name, "Portable Computing Language") != NULL;
 }
 
+/* Whether PoCL's kernel cache (POCL_CACHE_DIR, else XDG_CACHE_HOME/pocl, else
+ * HOME/.cache/pocl), where it writes every kernel it builds, takes a file of 64 KiB: if not,
+ * why, into why (a full disk, a path through a file). Returns 1 where it does not. */
+static int pocl_cache_unwritable(char *why, size_t n)
+{
+    char dir[1024], path[1100];
+    const char *env = getenv("POCL_CACHE_DIR"), *xdg = getenv("XDG_CACHE_HOME");
+    const char *home = getenv("HOME");
+    if (env && *env)
+        snprintf(dir, sizeof dir, "%s", env);
+    else if (xdg && *xdg)
+        snprintf(dir, sizeof dir, "%s/pocl", xdg);
+    else
+        snprintf(dir, sizeof dir, "%s/.cache/pocl", home ? home : "");
+    snprintf(path, sizeof path, "%s/.vbcl-probe-%ld", dir, (long)getpid());
+    static char block[65536];
+    FILE *f = fopen(path, "wb");
+    int bad = !f || fwrite(block, 1, sizeof block, f) != sizeof block || fflush(f) != 0;
+    int e = errno;
+    if (f && fclose(f) != 0 && !bad) {
+        bad = 1;
+        e = errno;
+    }
+    if (f) remove(path);
+    if (bad)
+        snprintf(why, n,
+                 "PoCL cannot write its kernel cache in %s (%s): free space there, or "
+                 "set POCL_CACHE_DIR to a writable directory",
+                 dir, strerror(e));
+    return bad;
+}
+
 /* Whether d's driver keeps compiled kernels of its own between runs: PoCL does, in
  * POCL_CACHE_DIR, unless POCL_KERNEL_CACHE is 0. */
 static int driver_caches_kernels(const VbDevice *d)
@@ -651,8 +689,13 @@ cl_program clu_program_build(VbDevice *d, const char *source, const char *option
     CL_CHECK_ERR(rc, "clCreateProgramWithSource", fail);
     rc = clBuildProgram(prog, 1, &d->device, options, NULL, NULL);
     if (rc != CL_SUCCESS) {
-        print_build_log(d, prog, options);
-        clu_fail(rc, "clBuildProgram", __FILE__, __LINE__);
+        char why[1400];
+        if (driver_caches_kernels(d) && pocl_cache_unwritable(why, sizeof why)) {
+            if (!first_error[0]) snprintf(first_error, sizeof first_error, "%s", why);
+        } else {
+            print_build_log(d, prog, options);
+            clu_fail(rc, "clBuildProgram", __FILE__, __LINE__);
+        }
         goto fail_program;
     }
     if (path[0]) { /* then the least recently used binaries go, beyond the cache's size */
@@ -668,6 +711,40 @@ fail:
     return NULL;
 }
 
+static void CL_CALLBACK free_host_memory(cl_mem m, void *mem)
+{
+    (void)m;
+    free(mem);
+}
+
+/* A buffer in memory vbcl allocates (d->host_memory): the driver uses it as it is
+ * (CL_MEM_USE_HOST_PTR) and frees nothing of it; the destructor callback frees it when the
+ * buffer goes. NULL, with the error recorded, where the allocation fails. */
+static cl_mem host_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags)
+{
+    void *mem = NULL;
+    if (posix_memalign(&mem, d->host_align, bytes)) {
+        if (!first_error[0])
+            snprintf(first_error, sizeof first_error, "out of memory allocating %.1f MiB",
+                     (double)bytes / 1048576.0);
+        return NULL;
+    }
+    if (data) memcpy(mem, data, bytes);
+    cl_int rc;
+    cl_mem m = clCreateBuffer(d->context, flags | CL_MEM_USE_HOST_PTR, bytes, mem, &rc);
+    if (rc != CL_SUCCESS) {
+        clu_fail(rc, "clCreateBuffer", __FILE__, __LINE__);
+        free(mem);
+        return NULL;
+    }
+    rc = clSetMemObjectDestructorCallback(m, free_host_memory, mem);
+    if (rc == CL_SUCCESS) return m;
+    clu_fail(rc, "clSetMemObjectDestructorCallback", __FILE__, __LINE__);
+    clReleaseMemObject(m);
+    free(mem);
+    return NULL;
+}
+
 cl_mem clu_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flags)
 {
     cl_int rc;
@@ -677,6 +754,7 @@ cl_mem clu_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_flags flag
         bytes = sizeof zeros;
         data = zeros;
     }
+    if (d->host_memory) return host_buffer(d, data, bytes, flags);
     cl_mem m = clCreateBuffer(d->context, flags | (data ? CL_MEM_COPY_HOST_PTR : 0), bytes,
                               (void *)data, &rc);
     if (rc != CL_SUCCESS) {

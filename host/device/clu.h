@@ -23,6 +23,11 @@ typedef struct VbDevice {
     char driver[128];  /* driver version */
     cl_ulong global_mem, max_alloc;
     size_t max_wg;
+    /* a device on the host's memory (a CPU): vbcl allocates its buffers itself (clu_buffer),
+     * aligned to host_align bytes, so that running out of memory is a message, not a
+     * driver's failure at the buffer's first use */
+    int host_memory;
+    size_t host_align;
     /* the programs built on this device, kept for later frames and renderers (released
      * by clu_device_close) */
     struct {

@@ -69,6 +69,20 @@ int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen)
                        errlen);
 }
 
+/* The message of a failed allocation of `bytes` for anti-aliasing's `what`: out of memory
+ * named with what would take less, or the device's error. */
+static void aa_alloc_failed(const VbDevice *d, const char *what, size_t bytes, char *err,
+                            size_t errlen)
+{
+    if (strncmp(clu_error(), "out of memory", 13) == 0)
+        snprintf(err, errlen,
+                 "out of memory for anti-aliasing's %s (%.0f MiB more on %s); raise the "
+                 "threshold, lower --aa-max-level or --aa-min-level, or render a smaller image",
+                 what, (double)bytes / 1048576.0, d->name);
+    else
+        snprintf(err, errlen, "%s: %s", d->name, clu_error());
+}
+
 /* Makes *buf hold at least `need` elements of `elem` bytes (capacity *cap), keeping its
  * first `keep` elements: a new buffer (aa_capacity), the old contents copied. Returns 0, 1
  * (device) or 2 (more than one allocation allows) with a message in err. */
@@ -90,7 +104,7 @@ static int aa_reserve(Renderer *r, cl_mem *buf, size_t *cap, size_t need, size_t
     return 0;
 fail:
     if (nb) CL_WARN(clReleaseMemObject(nb));
-    snprintf(err, errlen, "%s: %s", d->name, clu_error());
+    aa_alloc_failed(d, what, want * elem, err, errlen);
     return 1;
 }
 
@@ -130,7 +144,7 @@ static int aa_reserve_trees(AaState *aa, Renderer *r, size_t need, size_t keep, 
 fail:
     if (levels) CL_WARN(clReleaseMemObject(levels));
     if (values) CL_WARN(clReleaseMemObject(values));
-    snprintf(err, errlen, "%s: %s", d->name, clu_error());
+    aa_alloc_failed(d, "trees", want * (elem + VBCL_AA_CELLS), err, errlen);
     return 1;
 }
 
