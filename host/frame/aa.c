@@ -148,31 +148,55 @@ fail:
     return 1;
 }
 
+/* Waits for every launch and pass write in flight (clFinish) and adds each launch's device
+ * time to its fields. The host waits only where it needs a result (a count it decides on,
+ * the image), or where AA_PENDING are in flight: an in-order queue runs each command after
+ * the one before, so a launch needs no wait before the next is enqueued. Returns 0 or -1. */
+static int aa_settle(AaState *aa, Renderer *r)
+{
+    int rc = aa->npending || aa->npasses ? clFinish(r->dev->queue) == CL_SUCCESS ? 0 : -1 : 0;
+    for (int i = 0; i < aa->npending; i++) {
+        double ms = rc ? 0.0 : clu_event_ms(aa->pending[i]);
+        for (int k = 0; k < 2; k++)
+            if (aa->pending_ms[i][k]) *aa->pending_ms[i][k] += ms;
+        clReleaseEvent(aa->pending[i]);
+    }
+    aa->npending = aa->npasses = 0;
+    if (rc) clu_fail(CL_OUT_OF_RESOURCES, "clFinish", __FILE__, __LINE__);
+    return rc;
+}
+
 /* Enqueues kernel k over `global` work items with the given buffers as its arguments
- * (from argument `first` on) and waits; adds its device time to *ms. Returns 0 or -1. */
-static int aa_launch(Renderer *r, cl_kernel k, cl_uint first, const cl_mem *args, int nargs,
-                     size_t items, double *ms)
+ * (from argument `first` on), without waiting; its device time is added to *ms and *ms2
+ * (may be NULL) when the host next waits (aa_settle). Returns 0 or -1. */
+static int aa_launch(AaState *aa, Renderer *r, cl_kernel k, cl_uint first, const cl_mem *args,
+                     int nargs, size_t items, double *ms, double *ms2)
 {
     cl_event ev = NULL;
     size_t global = (items + 63) / 64 * 64;
+    if (aa->npending == AA_PENDING && aa_settle(aa, r)) return -1;
     for (int i = 0; i < nargs; i++)
         if (clu_set_arg(k, first + (cl_uint)i, sizeof(cl_mem), &args[i])) return -1;
     CL_CHECK(clEnqueueNDRangeKernel(r->dev->queue, k, 1, NULL, &global, renderer_local(r, global),
                                     0, NULL, &ev),
              fail);
-    CL_CHECK(clWaitForEvents(1, &ev), fail);
-    *ms += clu_event_ms(ev);
-    clReleaseEvent(ev);
+    aa->pending[aa->npending] = ev;
+    aa->pending_ms[aa->npending][0] = ms;
+    aa->pending_ms[aa->npending++][1] = ms2;
     return 0;
 fail:
-    if (ev) clReleaseEvent(ev);
     return -1;
 }
 
+/* Writes pass into aa->pass without waiting, from a copy that stays until the host next
+ * waits (aa_settle). Returns 0 or -1. */
 static int aa_write_pass(AaState *aa, Renderer *r, VbAaPass *pass)
 {
     pass->tree_cap = (unsigned)aa->tree_cap;
-    CL_CHECK(clEnqueueWriteBuffer(r->dev->queue, aa->pass, CL_TRUE, 0, sizeof *pass, pass, 0, NULL,
+    if (aa->npasses == AA_PENDING && aa_settle(aa, r)) return -1;
+    VbAaPass *copy = &aa->passes[aa->npasses++];
+    *copy = *pass;
+    CL_CHECK(clEnqueueWriteBuffer(r->dev->queue, aa->pass, CL_FALSE, 0, sizeof *copy, copy, 0, NULL,
                                   NULL),
              fail);
     return 0;
@@ -186,16 +210,16 @@ static int aa_trace_batch(AaState *aa, Renderer *r, cl_kernel gen, VbAaPass *pas
                           int nrays, RenderStats *st)
 {
     const cl_uint a = RENDER_FRAME_ARGS;
-    double gen_ms = 0.0, trace_ms = 0.0;
+    double trace_ms = 0.0;
     if (aa_write_pass(aa, r, pass) || renderer_set_frame_args(r, gen, r->rays, nrays, r->hits,
                                                               r->media, r->radiance, r->counters))
         return -1;
     const cl_mem args[2] = {aa->pass, aa->marks};
-    if (aa_launch(r, gen, a, args, with_marks ? 2 : 1, (size_t)nrays, &gen_ms) ||
+    if (aa_launch(aa, r, gen, a, args, with_marks ? 2 : 1, (size_t)nrays, &st->camera_ms,
+                  &st->aa_refine_ms) ||
         renderer_trace_rays(r, nrays, st, &trace_ms))
         return -1;
-    st->camera_ms += gen_ms;
-    st->aa_refine_ms += gen_ms + trace_ms;
+    st->aa_refine_ms += trace_ms;
     return 0;
 }
 
@@ -232,14 +256,15 @@ static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, uns
     const cl_mem args[9] = {aa->pass,  aa->film,   aa->slots, aa->levels, aa->values,
                             aa->marks, aa->counts, aa->split, aa->list};
     if (listed == AA_ALL
-            ? aa_launch(r, r->k_aa_contrast, 0, args, 8, npix, &st->aa_contrast_ms)
+            ? aa_launch(aa, r, r->k_aa_contrast, 0, args, 8, npix, &st->aa_contrast_ms, NULL)
             : aa_clear_split(aa, r, pass->round, npix) ||
-                  aa_launch(r, r->k_aa_contrast_list, 0, args, 9, listed, &st->aa_contrast_ms))
+                  aa_launch(aa, r, r->k_aa_contrast_list, 0, args, 9, listed, &st->aa_contrast_ms,
+                            NULL))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->counts, CL_TRUE, 0, sizeof(cl_uint) * AA_COUNTS,
                                  counts, 0, NULL, NULL),
              fail);
-    return 0;
+    return aa_settle(aa, r);
 fail:
     return -1;
 }
@@ -276,7 +301,8 @@ static int aa_split_batch(AaState *aa, Renderer *r, VbAaPass *pass, unsigned fir
     if (aa_trace_batch(aa, r, r->k_aa_split_rays, pass, 1, (int)(3 * k), st)) return -1;
     const cl_mem args[10] = {aa->pass,        aa->marks,  r->radiance, aa->film,   aa->slots,
                              aa->slot_pixels, aa->levels, aa->values,  aa->counts, aa->split};
-    if (aa_launch(r, r->k_aa_split_store, 0, args, 10, k, &st->aa_reconstruct_ms)) return -1;
+    if (aa_launch(aa, r, r->k_aa_split_store, 0, args, 10, k, &st->aa_reconstruct_ms, NULL))
+        return -1;
     st->samples += 3ull * k;
     return 0;
 }
@@ -309,11 +335,12 @@ static int aa_list_dirty(AaState *aa, Renderer *r, VbAaPass *pass, unsigned mark
                                   NULL, NULL),
              fail);
     const cl_mem args[5] = {aa->pass, aa->marks, aa->tags, aa->list, aa->list_count};
-    if (aa_launch(r, r->k_aa_dirty_list, 0, args, 5, marked, &st->aa_contrast_ms)) return -1;
+    if (aa_launch(aa, r, r->k_aa_dirty_list, 0, args, 5, marked, &st->aa_contrast_ms, NULL))
+        return -1;
     CL_CHECK(clEnqueueReadBuffer(r->dev->queue, aa->list_count, CL_TRUE, 0, sizeof(cl_uint), listed,
                                  0, NULL, NULL),
              fail);
-    return 0;
+    return aa_settle(aa, r);
 fail:
     return -1;
 }
@@ -394,8 +421,8 @@ static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, u
     pass->entries = slots;
     const cl_mem args[7] = {aa->pass, aa->slot_pixels, aa->levels, aa->values,
                             aa->film, aa->info,        aa->slots};
-    if (slots && (aa_write_pass(aa, r, pass) ||
-                  aa_launch(r, r->k_aa_resolve, 0, args, 7, slots, &st->aa_reconstruct_ms)))
+    if (slots && (aa_write_pass(aa, r, pass) || aa_launch(aa, r, r->k_aa_resolve, 0, args, 7, slots,
+                                                          &st->aa_reconstruct_ms, NULL)))
         return -1;
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
@@ -403,6 +430,7 @@ static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, u
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->info, CL_TRUE, 0, sizeof(int) * npix,
                                  aa->levels_host, 0, NULL, NULL),
              fail);
+    if (aa_settle(aa, r)) goto fail;
     st->samples_max = 1;
     for (size_t i = 0; i < npix; i++) {
         int info = aa->levels_host[i];
@@ -576,12 +604,13 @@ int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba,
         pass.entries = k;
         const cl_mem args[3] = {aa->pass, r->radiance, aa->film};
         if (aa_trace_batch(aa, r, r->k_aa_generate, &pass, 0, (int)(k * (unsigned)(n * n)), st) ||
-            aa_launch(r, r->k_aa_reconstruct, 0, args, 3, k, &st->aa_reconstruct_ms))
+            aa_launch(aa, r, r->k_aa_reconstruct, 0, args, 3, k, &st->aa_reconstruct_ms, NULL))
             goto fail;
     }
     CL_CHECK(clEnqueueReadBuffer(d->queue, aa->film, CL_TRUE, 0, sizeof(float) * 4 * npix, rgba, 0,
                                  NULL, NULL),
              fail);
+    if (aa_settle(aa, r)) goto fail;
     st->samples = (unsigned long long)npix * (unsigned long long)(n * n);
     st->samples_max = (unsigned)(n * n);
     return 0;
@@ -595,6 +624,8 @@ void aa_release(AaState *aa)
     cl_mem *mems[] = {&aa->pass,   &aa->film,   &aa->slots,       &aa->info,  &aa->counts,
                       &aa->levels, &aa->values, &aa->slot_pixels, &aa->marks, &aa->split,
                       &aa->list,   &aa->tags,   &aa->list_count};
+    for (int i = 0; i < aa->npending; i++) /* a failed frame's launches, never settled */
+        CL_WARN(clReleaseEvent(aa->pending[i]));
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; i++)
         if (*mems[i]) CL_WARN(clReleaseMemObject(*mems[i]));
     free(aa->levels_host);

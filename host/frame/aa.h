@@ -15,6 +15,9 @@
  * refined), each pixel's tree slot, the trees (per refined pixel 256 bytes of levels and
  * 340 node values of 16 bytes, aa_tree.h; grown as pixels are refined), the list of marked
  * nodes and the counters. */
+/* The launches and pass writes in flight at most before the host waits for them. */
+#define AA_PENDING 32
+
 typedef struct AaState {
     cl_mem pass, film, slots, info, counts;
     cl_mem split;                  /* two rounds' split blocks of each pixel (aa_contrast_mark) */
@@ -25,6 +28,13 @@ typedef struct AaState {
     size_t npix;      /* the frame's pixels: the most tree slots it can need */
     int *levels_host; /* after an adaptive render: each pixel's deepest level, else NULL */
     int *leaves_host; /* after an adaptive render: each pixel's number of leaves, else NULL */
+    /* launches not waited for (aa.c, aa_settle): their events and the times they add to, and
+     * the passes written from here without waiting */
+    cl_event pending[AA_PENDING];
+    double *pending_ms[AA_PENDING][2];
+    int npending;
+    VbAaPass passes[AA_PENDING];
+    int npasses;
 } AaState;
 
 /* Refines rgba (the pass-0 image, one ray per pixel centre) adaptively: each round marks
