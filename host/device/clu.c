@@ -93,12 +93,22 @@ const char *clu_error_name(cl_int code)
     }
 }
 
+/* Whether the first recorded failure was a failed allocation (clu_error_out_of_memory). */
+static _Thread_local int first_error_oom;
+
 int clu_fail(cl_int code, const char *call, const char *file, int line)
 {
-    if (!first_error[0])
+    if (!first_error[0]) {
         snprintf(first_error, sizeof first_error, "%s failed: %s (%d) at %s:%d", call,
                  clu_error_name(code), (int)code, file, line);
+        first_error_oom = code == CL_OUT_OF_HOST_MEMORY || code == CL_MEM_OBJECT_ALLOCATION_FAILURE;
+    }
     return -1;
+}
+
+int clu_error_out_of_memory(void)
+{
+    return first_error[0] && first_error_oom;
 }
 
 const char *clu_error(void)
@@ -108,6 +118,7 @@ const char *clu_error(void)
 void clu_error_clear(void)
 {
     first_error[0] = 0;
+    first_error_oom = 0;
 }
 
 double clu_now_ms(void)
@@ -724,9 +735,11 @@ static cl_mem host_buffer(VbDevice *d, const void *data, size_t bytes, cl_mem_fl
 {
     void *mem = NULL;
     if (posix_memalign(&mem, d->host_align, bytes)) {
-        if (!first_error[0])
+        if (!first_error[0]) {
             snprintf(first_error, sizeof first_error, "out of memory allocating %.1f MiB",
                      (double)bytes / 1048576.0);
+            first_error_oom = 1;
+        }
         return NULL;
     }
     if (data) memcpy(mem, data, bytes);

@@ -37,6 +37,11 @@ typedef struct VbDevice {
     int nkept;
 } VbDevice;
 
+/* Whether the first failure recorded since clu_error_clear was a failed allocation (the
+ * host's, CL_OUT_OF_HOST_MEMORY or CL_MEM_OBJECT_ALLOCATION_FAILURE): the caller names what
+ * it was allocating and what would take less. */
+int clu_error_out_of_memory(void);
+
 /* The name of an OpenCL error code ("CL_OUT_OF_RESOURCES"). */
 const char *clu_error_name(cl_int code);
 

@@ -53,7 +53,7 @@ int scene_buffers_upload(SceneBuffers *b, VbDevice *dev, const CompiledScene *cs
 #define SCENE_BUFFER_MADE(space, type, name, field) &&b->field
     if (1 VBCL_SCENE_BUFFERS(SCENE_BUFFER_MADE)) return 0;
 #undef SCENE_BUFFER_MADE
-    if (strncmp(clu_error(), "out of memory", 13) == 0)
+    if (clu_error_out_of_memory())
         snprintf(err, errlen,
                  "%s: out of memory for the scene's buffers on %s (%.0f MiB of triangles, grid "
                  "and camera tiles); fewer triangles or a coarser grid (render.grid) take less",

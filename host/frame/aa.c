@@ -74,7 +74,7 @@ int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen)
 static void aa_alloc_failed(const VbDevice *d, const char *what, size_t bytes, char *err,
                             size_t errlen)
 {
-    if (strncmp(clu_error(), "out of memory", 13) == 0)
+    if (clu_error_out_of_memory())
         snprintf(err, errlen,
                  "out of memory for anti-aliasing's %s (%.0f MiB more on %s); raise the "
                  "threshold, lower --aa-max-level or --aa-min-level, or render a smaller image",
