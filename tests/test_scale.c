@@ -140,6 +140,10 @@ static void test_scale_stats_per_device(void)
     const cJSON *tiles = cJSON_GetObjectItemCaseSensitive(doc, "tiles");
     const cJSON *rays = cJSON_GetObjectItemCaseSensitive(doc, "rays");
     CHECK(cJSON_GetArraySize(devs) == 2, "devices: %d entries", cJSON_GetArraySize(devs));
+    /* one compilation of the scene, which both devices upload */
+    const cJSON *compile = cJSON_GetObjectItemCaseSensitive(doc, "compile");
+    CHECK(json_num(compile, "scenes") == 1, "two devices: %.0f scene compilations",
+          json_num(compile, "scenes"));
     double sum_tiles = 0, sum_rays = 0;
     const cJSON *d;
     cJSON_ArrayForEach(d, devs)
