@@ -154,16 +154,16 @@ fail:
  * the one before, so a launch needs no wait before the next is enqueued. Returns 0 or -1. */
 static int aa_settle(AaState *aa, Renderer *r)
 {
-    int rc = aa->npending || aa->npasses ? clFinish(r->dev->queue) == CL_SUCCESS ? 0 : -1 : 0;
+    cl_int done = CL_SUCCESS;
+    if (aa->npending || aa->npasses) done = clFinish(r->dev->queue);
     for (int i = 0; i < aa->npending; i++) {
-        double ms = rc ? 0.0 : clu_event_ms(aa->pending[i]);
+        double ms = done == CL_SUCCESS ? clu_event_ms(aa->pending[i]) : 0.0;
         for (int k = 0; k < 2; k++)
             if (aa->pending_ms[i][k]) *aa->pending_ms[i][k] += ms;
         clReleaseEvent(aa->pending[i]);
     }
     aa->npending = aa->npasses = 0;
-    if (rc) clu_fail(CL_OUT_OF_RESOURCES, "clFinish", __FILE__, __LINE__);
-    return rc;
+    return done == CL_SUCCESS ? 0 : clu_fail(done, "clFinish", __FILE__, __LINE__);
 }
 
 /* Enqueues kernel k over `global` work items with the given buffers as its arguments
