@@ -519,11 +519,12 @@ static int driver_is_pocl(const VbDevice *d)
 }
 
 /* Whether PoCL's kernel cache (POCL_CACHE_DIR, else XDG_CACHE_HOME/pocl, else
- * HOME/.cache/pocl), where it writes every kernel it builds, takes a file of 64 KiB: if not,
- * why, into why (a full disk, a path through a file). Returns 1 where it does not. */
+ * HOME/.cache/pocl), where it writes every kernel it builds, takes a file of 64 KiB (written
+ * as vbcl writes any file, file_write_whole, then removed): if not, why, into why (a full
+ * disk, a path through a file). Returns 1 where it does not. */
 static int pocl_cache_unwritable(char *why, size_t n)
 {
-    char dir[1024], path[1100];
+    char dir[1024], path[1100], err[1400];
     const char *env = getenv("POCL_CACHE_DIR"), *xdg = getenv("XDG_CACHE_HOME");
     const char *home = getenv("HOME");
     if (env && *env)
@@ -533,21 +534,16 @@ static int pocl_cache_unwritable(char *why, size_t n)
     else
         snprintf(dir, sizeof dir, "%s/.cache/pocl", home ? home : "");
     snprintf(path, sizeof path, "%s/.vbcl-probe-%ld", dir, (long)getpid());
-    static char block[65536];
-    FILE *f = fopen(path, "wb");
-    int bad = !f || fwrite(block, 1, sizeof block, f) != sizeof block || fflush(f) != 0;
-    int e = errno;
-    if (f && fclose(f) != 0 && !bad) {
-        bad = 1;
-        e = errno;
+    static const char block[65536];
+    if (file_write_whole(path, block, sizeof block, err, sizeof err) == 0) {
+        remove(path);
+        return 0;
     }
-    if (f) remove(path);
-    if (bad)
-        snprintf(why, n,
-                 "PoCL cannot write its kernel cache in %s (%s): free space there, or "
-                 "set POCL_CACHE_DIR to a writable directory",
-                 dir, strerror(e));
-    return bad;
+    snprintf(why, n,
+             "PoCL cannot write its kernel cache in %s (%s): free space there, or set "
+             "POCL_CACHE_DIR to a writable directory",
+             dir, err);
+    return 1;
 }
 
 /* Whether d's driver keeps compiled kernels of its own between runs: PoCL does, in
