@@ -593,7 +593,8 @@ int compiled_scene_update(CompiledScene *cs, const Scene *s, size_t max_alloc, c
     if (cs->geometry_built) {
         geometry_free(cs);
         rc = geometry_make(cs, s, err, errlen);
-        if (!rc && !(cs->key = key_make(s))) {
+        /* only an animation has a next frame to compare with: a still keeps no copy */
+        if (!rc && s->animated && !(cs->key = key_make(s))) {
             snprintf(err, errlen, "out of memory");
             rc = 1;
         }
