@@ -15,10 +15,15 @@ OPT     ?= -O2 -g
 SANFLAGS := $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer -fno-sanitize-recover=all)
 
 # Dependencies come from pkg-config; build/config.mk records them once they are found,
-# running scripts/install-deps.sh first when one is missing.
+# running scripts/install-deps.sh first when one is missing. It is made again when OpenMPI
+# came or went since (`make test` installs it after `make run` built without it).
 NO_CONFIG_GOALS := clean format format-check deps
 ifeq ($(filter $(NO_CONFIG_GOALS),$(MAKECMDGOALS)),)
 -include build/config.mk
+MPI_NOW := $(shell pkg-config --exists ompi-c 2>/dev/null && echo 1 || echo 0)
+ifneq ($(MPI_FOUND),$(MPI_NOW))
+build/config.mk: FORCE
+endif
 endif
 
 # The host's folders (docs/architecture.md, "The host's layers"): each on the include path,
@@ -68,9 +73,11 @@ build/config.mk: scripts/install-deps.sh Makefile
 	      echo "PKG_LIBS := $$(pkg-config --libs OpenCL libcjson)"; \
 	      echo "OIIO_LIBS := $$(pkg-config --libs OpenImageIO)"; \
 	      if pkg-config --exists ompi-c 2>/dev/null; then \
+	        echo "MPI_FOUND := 1"; \
 	        echo "MPI_CFLAGS := -DVBCL_MPI $$(pkg-config --cflags ompi-c)"; \
 	        echo "MPI_LIBS := $$(pkg-config --libs ompi-c)"; \
-	      else echo "# no MPI (libopenmpi-dev): vbcl runs as one process"; fi; } > $@
+	      else echo "# no MPI (libopenmpi-dev): vbcl runs as one process"; \
+	        echo "MPI_FOUND := 0"; fi; } > $@
 
 deps:
 	scripts/install-deps.sh

@@ -2,18 +2,20 @@
 # install-deps.sh — installs what vbcl needs from Debian's packages, only what is missing.
 # Idempotent: a second run installs nothing. Uses sudo when not root.
 # usage: scripts/install-deps.sh [--test | --bench]
-#   (none)   what building and rendering need (`make run`): a compiler, OpenCL with PoCL,
-#            cJSON, OpenImageIO, OpenMPI (vbcl is built with MPI where it is installed)
+#   (none)   what building and rendering on one machine need (`make run`): a compiler,
+#            OpenCL with PoCL, cJSON, OpenImageIO
 #   --test   and what the tests and checks need (`make test`, `make oclgrind`, `make fuzz`):
-#            clinfo, oclgrind, clang (the fuzzers), OpenImageIO's tools (idiff), Python
-#            with NumPy and Matplotlib (the gallery and bench scripts)
+#            OpenMPI (vbcl is built with MPI where it is installed, docs/scaling.md; the
+#            Makefile rebuilds with it once it appears), clinfo, oclgrind, clang (the
+#            fuzzers), OpenImageIO's tools (idiff), Python with NumPy and Matplotlib (the
+#            gallery and bench scripts)
 #   --bench  and, for `make bench`, Embree 3 (libembree-dev), which the bench part "embree"
 #            traces the same rays with (docs/benchmarks.md); the renderer never links it.
 set -eu
 
 PACKAGES="build-essential pkg-config ocl-icd-opencl-dev opencl-headers pocl-opencl-icd \
-libcjson-dev libopenimageio-dev libopenmpi-dev openmpi-bin"
-TEST_PACKAGES="clinfo oclgrind clang openimageio-tools python3 python3-numpy python3-matplotlib \
+libcjson-dev libopenimageio-dev"
+TEST_PACKAGES="libopenmpi-dev openmpi-bin clinfo oclgrind clang openimageio-tools python3 python3-numpy python3-matplotlib \
 python3-venv"
 BENCH_PACKAGES="libembree-dev"
 
