@@ -371,8 +371,8 @@ typedef struct VbFrame {
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
- * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
- * kernel's time). Each ray has VBCL_SPLIT_SLOTS records; further splits of the same tree are
+ * traced by its second launch (so that the time spent in dispersive subtrees is that
+ * launch's time). Each ray has VBCL_SPLIT_SLOTS records; further splits of the same tree are
  * traced inline. Device data only: the host sizes the buffer. */
 #define VBCL_SPLIT_SLOTS 2
 typedef struct VbSplit {
