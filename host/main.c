@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "aa.h"
+#include "aa_map.h"
 #include "frame.h"
 #include "clu.h"
 #include "diag.h"
@@ -102,9 +103,13 @@ static const char usage_text[] =
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's deepest refinement level as a heat map\n"
-    "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
+    "                           (dark 0, blue 1, green 2, yellow 3, red 4), a legend of\n"
+    "                           the levels' colours and numbers to its right (the map\n"
+    "                           stays the image's top-left WIDTH x HEIGHT pixels); frames\n"
+    "                           are numbered as with -o\n"
     "      --aa-samples-map FILE  write each pixel's number of samples as a heat map on the\n"
-    "                           same colours (dark 1, blue 4, green 16, yellow 64, red 256)\n"
+    "                           same colours (dark 1, blue 4, green 16, yellow 64, red\n"
+    "                           256), its legend a colour bar marked 1, 4, 16, 64, 256\n"
     "      --device INDEX|NAME|all|LIST  OpenCL device (also VBCL_DEVICE; default: device 0);\n"
     "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
     "                           tiles among several (refinement runs on the first)\n"
@@ -461,25 +466,19 @@ static int needs_image_library(const Options *o, const Scene *s)
            (o->aa_samples_map && !image_is_native_format(o->aa_samples_map));
 }
 
-/* Writes each pixel's refinement level (aa_level_colour) or, with samples set, its number
- * of samples (aa_samples_colour) as a heat map. */
+/* Writes each pixel's refinement level or, with samples set, its number of samples as a
+ * heat map with its legend to the right (aa_map_image: the map stays the image's top-left
+ * width x height pixels). */
 static int write_aa_map(const char *path, const Scene *s, const int *values, int samples, char *err,
                         size_t errlen)
 {
-    size_t npix = (size_t)s->width * (size_t)s->height;
-    float *map = malloc(sizeof(float) * 4 * npix);
+    AaMapLegend lg;
+    float *map = aa_map_image(values, s->width, s->height, samples, s->aa_max_level, &lg);
     if (!map) {
         snprintf(err, errlen, "out of memory for the anti-aliasing map");
         return -1;
     }
-    for (size_t i = 0; i < npix; i++) {
-        if (samples)
-            aa_samples_colour(values[i], map + 4 * i);
-        else
-            aa_level_colour(values[i], map + 4 * i);
-        map[4 * i + 3] = 1.0f;
-    }
-    int rc = image_write(path, s->width, s->height, map, 0.0f, err, errlen);
+    int rc = image_write(path, lg.width, lg.height, map, 0.0f, err, errlen);
     free(map);
     return rc;
 }

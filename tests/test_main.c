@@ -138,6 +138,7 @@ int main(int argc, char **argv)
     suite_stability();
     suite_render();
     suite_aa();
+    suite_aa_map();
     suite_dispersion();
     suite_structure();
     suite_scale();

@@ -43,6 +43,7 @@ void suite_patterns(void);
 void suite_stability(void);
 void suite_render(void);
 void suite_aa(void);
+void suite_aa_map(void);
 void suite_dispersion(void);
 void suite_structure(void);
 void suite_scale(void);
