@@ -732,7 +732,7 @@ static int render_tiles_for_rank0(Dist *d, Scene *scene, VbDevice *devs, int nde
         rc = frame_init(&fr, devs, ndev, &s, &st, err, sizeof err);
     if (!rc) {
         fr.tiles = &src;
-        rc = frame_pixel_centres(&fr, &s, rgba, &st, 0, err, sizeof err);
+        rc = frame_pixel_centres(&fr, rgba, &st, 0, err, sizeof err);
     }
     if (dist_tiles_report(d, rc, err, &st, fr.work, frame_devices(&fr))) rc = 1;
     frame_release(&fr);
