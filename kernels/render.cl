@@ -116,15 +116,29 @@ VB_INLINE uint sample_key(__constant const VbFrame *f, uint sample)
     return vb_hash(sample ^ vb_hash(f->seed));
 }
 
+/* The place in the image of pixel p of the frame's window (VbFrame.window_x ...: row by
+ * row, window_width a row). */
+VB_INLINE int2 frame_pixel_xy(__constant const VbFrame *f, uint p)
+{
+    return (int2)(f->window_x + (int)(p % (uint)f->window_width),
+                  f->window_y + (int)(p / (uint)f->window_width));
+}
+
+/* The index in the whole image (row-major) of the pixel at xy: the id of its pass-0 sample
+ * and the key of its supersamples' ids, whatever window renders it. */
+VB_INLINE uint frame_pixel_index(__constant const VbFrame *f, int2 xy)
+{
+    return (uint)(xy.y * f->width + xy.x);
+}
+
 /* frame -> rays: one ray through the centre of each pixel of the tile; the sample id is
- * the pixel index. */
+ * the pixel's index in the image. */
 __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);
     if (i >= f->tile_pixels) return;
-    int pixel = f->first_pixel + i;
-    int x = pixel % f->width, y = pixel / f->width;
-    rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)pixel);
+    int2 xy = frame_pixel_xy(f, (uint)(f->first_pixel + i));
+    rays[i] = camera_ray(f, (float)xy.x + 0.5f, (float)xy.y + 0.5f, frame_pixel_index(f, xy));
 }
 
 /* This work group's copy of the counters (VBCL_COUNTER_SLOTS in types.h). */
@@ -368,24 +382,24 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
 #endif
 
 /* frame -> rays: uniform supersampling, side x side rays through the subpixel centres of
- * each pixel of a batch of pixels from aa->first on (complete stratification), ray i
- * belonging to pixel first + i / side^2 and subpixel i % side^2 (row-major). */
+ * each pixel of a batch of pixels of the window from aa->first on (complete
+ * stratification), ray i belonging to pixel first + i / side^2 and subpixel i % side^2
+ * (row-major). */
 __kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
-    uint n = (uint)(aa->side * aa->side);
-    uint pixel = aa->first + (uint)i / n, sub = (uint)i % n;
-    int x = (int)(pixel % (uint)f->width), y = (int)(pixel / (uint)f->width);
+    uint n = (uint)(aa->side * aa->side), sub = (uint)i % n;
+    int2 xy = frame_pixel_xy(f, aa->first + (uint)i / n);
     float inv = 1.0f / (float)aa->side;
-    float px = (float)x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
-    float py = (float)y + ((float)(sub / (uint)aa->side) + 0.5f) * inv;
-    rays[i] = camera_ray(f, px, py, aa_sample_id(pixel, aa->side, sub));
+    float px = (float)xy.x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
+    float py = (float)xy.y + ((float)(sub / (uint)aa->side) + 0.5f) * inv;
+    rays[i] = camera_ray(f, px, py, aa_sample_id(frame_pixel_index(f, xy), aa->side, sub));
 }
 
 /* frame, marks -> rays: three rays per marked node of a batch, through the samples of the
  * three children that do not hold the node's own sample (aa_tree.h): ray i belongs to
- * mark first + i / 3. */
+ * mark first + i / 3 (its pixel one of the window's). */
 __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
                             __global const uint2 *marks)
 {
@@ -395,9 +409,10 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     uint child = aa_new_child(m.y, i % 3);
     int cell = aa_new_child_cell(child);
     float2 at = aa_cell_position(cell);
-    int x = (int)(m.x % (uint)f->width), y = (int)(m.x / (uint)f->width);
-    rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,
-                         aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
+    int2 xy = frame_pixel_xy(f, m.x);
+    rays[i] =
+        camera_ray(f, (float)xy.x + at.x, (float)xy.y + at.y,
+                   aa_tree_sample_id(frame_pixel_index(f, xy), (uint)cell, aa_node_level(child)));
 }
 
 #endif

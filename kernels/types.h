@@ -107,8 +107,8 @@ typedef struct VbRay {
     float org[3];
     float tmax;          /* farthest accepted hit distance (in units of |dir|) */
     float dir[3];        /* unit length */
-    unsigned int sample; /* the film sample's id, the key of its shading jitter: the pixel
-                          * index for a ray through a pixel's centre, a hash of (pixel,
+    unsigned int sample; /* the film sample's id, the key of its shading jitter: the pixel's
+                          * index in the image for a ray through its centre, a hash of (pixel,
                           * samples per axis, subpixel) for a supersample (aa_sample_id) */
 } VbRay;
 
@@ -306,7 +306,7 @@ typedef struct VbAaPass {
     float threshold;       /* a pair of neighbours fails when |a-b| / max(a+b, floor) > threshold */
     float contrast_scale;  /* values are scaled by 2^exposure and clamped to [0, 1] first */
     int max_level;         /* nodes at this level are never split */
-    int width, height;     /* image size in pixels */
+    int width, height;     /* the film's size in pixels: the frame's window (VbFrame) */
     int side;              /* uniform batch: samples per pixel axis (N of --ssaa) */
     float floor;           /* contrast: a + b below this counts as this (dark noise) */
     unsigned int first;    /* batch: its first entry in the list of marked nodes (or pixels) */
@@ -326,7 +326,7 @@ typedef struct VbFrame {
     float background[4]; /* rgb radiance of rays that leave the scene */
     float ambient[4];    /* rgb ambient light */
     int width, height;   /* full image size in pixels */
-    int first_pixel;     /* index of the tile's first pixel in the image (row-major) */
+    int first_pixel;     /* index of the tile's first pixel in the window (row-major) */
     int tile_pixels;     /* pixels in this tile */
     unsigned int nlights;
     unsigned int ntris;
@@ -345,6 +345,13 @@ typedef struct VbFrame {
                                    * this many times as many (1: never; light_reflect_area) */
     unsigned int pad[2];
     VbCamTiles cam_tiles;
+    /* The window: the part of the image the frame renders (host/frame/frame.h, frame_window:
+     * a --crop region and the anti-aliasing's margin around it; the whole image without
+     * --crop). Tiles, the film and the anti-aliasing's pixel indices count its pixels, row
+     * by row (window_width a row); camera rays and sample ids use the pixel's place in the
+     * whole image, so a pixel renders the same in any window. */
+    int window_x, window_y; /* its top-left pixel in the image */
+    int window_width, window_height;
 } VbFrame;
 
 /* VbFrame.flags */
@@ -414,7 +421,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(VBCL_OFFSETOF(VbFrame, window_x)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(VBCL_OFFSETOF(VbAaPass, tree_cap)) X(VBCL_OFFSETOF(VbAaPass, pairs)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -462,7 +469,8 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane_eps) == 44, object_plane_eps);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, hi) == 48, object_hi);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane) == 64, object_plane);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 304, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 320, frame_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, window_x) == 304, frame_window_x);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, cam_tiles) == 256, frame_cam_tiles);
 VBCL_STATIC_ASSERT(sizeof(VbCamTiles) == 48, cam_tiles_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbCamTiles, nx) == 32, cam_tiles_nx);

@@ -144,5 +144,6 @@ int main(int argc, char **argv)
     suite_scale();
     suite_faults();
     suite_frame();
+    suite_crop();
     return th_summary();
 }

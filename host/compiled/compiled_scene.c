@@ -286,6 +286,8 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     memcpy(f->ambient, s->ambient, sizeof s->ambient);
     f->width = s->width;
     f->height = s->height;
+    f->window_width = s->width; /* the whole image, unless the frame driver crops it */
+    f->window_height = s->height;
     f->nlights = (unsigned)s->nlights;
     f->ntris = s->mesh.ntris;
     unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));

@@ -329,6 +329,7 @@ static void render_defaults(Scene *s)
     s->aa_reconstruct = SCENE_AA_NEAREST;
     s->aa_pairs = SCENE_AA_PAIRS_FIRST;
     s->ssaa = 1;
+    s->crop_margin = -1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
     s->shadow_jitter = 1;

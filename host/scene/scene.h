@@ -123,6 +123,12 @@ typedef struct Scene {
     int aa_reconstruct;   /* SCENE_AA_NEAREST or SCENE_AA_LEAVES */
     int aa_pairs;         /* SCENE_AA_PAIRS_FIRST or SCENE_AA_PAIRS_BOTH */
     int ssaa;             /* uniform N x N supersampling (command line only); 1: off */
+    int crop[4];          /* --crop (command line only): the region written, x0, y0, x1, y1 in
+                           * pixels (x1, y1 one past its last column and row); all 0: none,
+                           * the whole image */
+    int crop_margin;      /* --crop-margin (command line only): pixels rendered around the
+                           * region for adaptive anti-aliasing's contrast test; -1: its whole
+                           * reach (frame_window) */
     int bands;            /* render.bands: wavelength bands of a dispersive split */
     int band_layout;      /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
                            * dispersive material uses the thesis model */
