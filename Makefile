@@ -327,4 +327,4 @@ format-check:
 clean:
 	rm -rf build vbcl
 
--include $(shell find build -name '*.d' 2>/dev/null)
+-include $(shell find build $(BUILD) -name '*.d' 2>/dev/null | sort -u)
