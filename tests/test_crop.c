@@ -436,21 +436,7 @@ static void expect_refused(const char *args, const char *needle)
                          " \"lights\": [{\"centre\": [2, 4, 3], \"radius\": 0.5, \"flux\": 500}],"
                          " \"materials\": {\"m\": {}}, \"objects\": [{\"shape\": \"sphere\", "
                          "\"material\": \"m\"}]}");
-    char img[512], cmd[2048], out[8192], buf[64];
-    snprintf(img, sizeof img, "%s/crop_keep.pfm", tu_tmpdir());
-    FILE *f = fopen(img, "w");
-    if (f) {
-        fputs("previous image", f);
-        fclose(f);
-    }
-    snprintf(cmd, sizeof cmd, "timeout 60 %s %s -o %s %s", tu_vbcl, scene, img, args);
-    int rc = tu_run(cmd, out, sizeof out);
-    char *nl = strchr(out, '\n');
-    CHECK(rc == 2, "%s: exit 2 (got %d): %s", args, rc, out);
-    CHECK(strstr(out, needle) != NULL, "%s: the message names \"%s\": %s", args, needle, out);
-    CHECK(nl && nl[1] == 0, "%s: one line: %s", args, out);
-    CHECK(strcmp(tu_read_file(img, buf, sizeof buf), "previous image") == 0,
-          "%s: the output untouched", args);
+    tu_expect_refused(scene, args, needle);
 }
 
 static void test_crop_refused(void)

@@ -27,6 +27,11 @@ const char *tu_write_file(const char *name, const char *text);
  * cannot be opened); returns buf. */
 char *tu_read_file(const char *path, char *buf, size_t n);
 
+/* Runs vbcl on the scene file at scene_path with args, writing to an output file that
+ * already holds an older image, and checks what every refusal of bad input does: exit 2,
+ * one line that contains needle, the older file untouched. */
+void tu_expect_refused(const char *scene_path, const char *args, const char *needle);
+
 /* Whether directory dir holds a file whose name contains part. */
 int tu_dir_has(const char *dir, const char *part);
 
