@@ -327,4 +327,6 @@ format-check:
 clean:
 	rm -rf build vbcl
 
--include $(shell find build -name '*.d' 2>/dev/null)
+# The header dependencies of every build folder: build/'s, and BUILD's where it lies elsewhere
+# (make BUILD=/tmp/b ...), so that a changed header rebuilds what includes it there too.
+-include $(shell find $(sort build $(BUILD)) -name '*.d' 2>/dev/null)
