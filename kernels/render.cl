@@ -21,6 +21,7 @@
 #define VBCL_RENDER_CL
 
 #include "aa.cl"
+#include "environment.cl"
 #include "light.cl"
 #include "medium.cl"
 #include "scene.cl"
@@ -197,7 +198,7 @@ VB_INLINE void shade_flush_counts(__global uint *counters, const TraceCount *tc,
 }
 
 /* rays, hits, media -> radiance (rgb + 1 per ray): the k_local term at each primary hit
- * with shadow feelers, or the background for rays that left the scene. */
+ * with shadow feelers, or the environment or background for rays that left the scene. */
 __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);
@@ -213,7 +214,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
     if (tracked) before = media[i];
 #endif
     if (h.tri < 0) {
-        col = vb_cload3(f->background);
+        col = scene_escape_radiance(&sc, dir);
 #ifdef VBCL_HAS_MEDIA
         if (tracked) col *= medium_absorb(&sc, medium_material(&sc, before), INFINITY);
 #endif
@@ -261,7 +262,7 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share
         VbMedium state = tr.medium;
         PathHit ph;
         if (!tree_trace(sc, &tr, &state, &ph, tc, &cnt->passes)) {
-            acc += tr.weight * vb_cload3(f->background) *
+            acc += tr.weight * scene_escape_radiance(sc, tr.dir) *
                    medium_absorb(sc, medium_material(sc, state), INFINITY);
             continue;
         }

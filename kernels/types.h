@@ -18,7 +18,8 @@
 #define VBCL_FEATURE_FRESNEL_THESIS (1u << 6) /* split by thesis eq. 9, not Fresnel */
 #define VBCL_FEATURE_PATTERNS       (1u << 7) /* some material has a surface pattern */
 #define VBCL_FEATURE_DISPERSION     (1u << 8) /* some dielectric's eta depends on wavelength */
-#define VBCL_FEATURE_COUNT          9
+#define VBCL_FEATURE_ENVIRONMENT    (1u << 9) /* rays that leave the scene see image.environment */
+#define VBCL_FEATURE_COUNT          10
 
 /* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
 #define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
@@ -319,6 +320,19 @@ typedef struct VbAaPass {
                 * raster order (0, the thesis's) or both (1) (SCENE_AA_PAIRS_*) */
 } VbAaPass;
 
+/* The environment (image.environment, kernels/environment.cl): a latitude-longitude image in
+ * the texels, seen by every ray that leaves the scene (VBCL_FRAME_ENVIRONMENT). A direction
+ * d is looked up at e = rot d (rot's rows: the world-to-environment rotation), u =
+ * atan2(e.x, -e.z) / 2pi in [0, 1) and v = acos(e.y) / pi, bilinearly between texel centres
+ * along u (x = u width - 1/2, wrapping) and between rows along v (y = v (height - 1): row 0
+ * the zenith, the last the nadir), as Mitsuba 3's envmap. */
+typedef struct VbEnvironment {
+    float rot[3][4];    /* rows of the world-to-environment rotation ([k][3] unused, 0) */
+    unsigned int first; /* its first texel (4 floats each) in the texels, row 0 first */
+    int width, height;  /* texels */
+    unsigned int pad;
+} VbEnvironment;
+
 /* Everything a frame's kernels read besides the big buffers. */
 typedef struct VbFrame {
     VbCamera camera;
@@ -352,6 +366,8 @@ typedef struct VbFrame {
      * whole image, so a pixel renders the same in any window. */
     int window_x, window_y; /* its top-left pixel in the image */
     int window_width, window_height;
+    VbEnvironment env; /* with VBCL_FRAME_ENVIRONMENT: what rays leaving the scene see
+                        * instead of background */
 } VbFrame;
 
 /* VbFrame.flags */
@@ -373,6 +389,7 @@ typedef struct VbFrame {
 #define VBCL_FRAME_TEXTURES        256u  /* some object holds a volume texture */
 #define VBCL_FRAME_DISPERSION      512u  /* some transparent material disperses: split records */
 #define VBCL_FRAME_ABSORPTION      1024u /* some transparent material has an extinction > 0 */
+#define VBCL_FRAME_ENVIRONMENT     2048u /* rays that leave the scene see env, not background */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64    /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
@@ -421,7 +438,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(VBCL_OFFSETOF(VbFrame, window_x)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(VBCL_OFFSETOF(VbFrame, window_x)) X(VBCL_OFFSETOF(VbFrame, env)) X(sizeof(VbEnvironment)) X(VBCL_OFFSETOF(VbEnvironment, first)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(VBCL_OFFSETOF(VbAaPass, tree_cap)) X(VBCL_OFFSETOF(VbAaPass, pairs)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -469,9 +486,12 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane_eps) == 44, object_plane_eps);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, hi) == 48, object_hi);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane) == 64, object_plane);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 320, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 384, frame_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, window_x) == 304, frame_window_x);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, cam_tiles) == 256, frame_cam_tiles);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, env) == 320, frame_env);
+VBCL_STATIC_ASSERT(sizeof(VbEnvironment) == 64, environment_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbEnvironment, first) == 48, environment_first);
 VBCL_STATIC_ASSERT(sizeof(VbCamTiles) == 48, cam_tiles_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbCamTiles, nx) == 32, cam_tiles_nx);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, flags) == 236, frame_flags);
@@ -533,6 +553,6 @@ VBCL_STATIC_ASSERT(VBCL_COUNTERS <= VBCL_COUNTER_STRIDE && VBCL_COUNTER_STRIDE %
     X(__global, VbObject, objects, objects)                                                        \
     X(__global, VbLight, lights, lights)                                                           \
     X(__global, VbPattern, patterns, patterns)                                                     \
-    X(__global, float, texels, texels) /* projected images, 4 floats per texel */
+    X(__global, float, texels, texels) /* images, band tables, environment: 4 floats each */
 
 #endif

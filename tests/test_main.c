@@ -155,6 +155,7 @@ int main(int argc, char **argv)
     suite_cli();
     suite_optics();
     suite_patterns();
+    suite_environment();
     suite_stability();
     suite_render();
     suite_aa();

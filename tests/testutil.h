@@ -55,6 +55,7 @@ void suite_scale(void);
 void suite_faults(void);
 void suite_frame(void);
 void suite_crop(void);
+void suite_environment(void);
 
 /* A test that runs probe kernels (tests/fixture.c): with workers (vbcl-tests -j), all such
  * tests run in one worker, which compiles each probe kernel once at its first launch while

@@ -91,7 +91,9 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
                 !clu_program_seen(r->dev, vbcl_film_source, film_options);
     if (fresh && build_notice_on) {
         char feat[160];
-        features_describe(r->program_features & ~VBCL_FEATURE_FRESNEL_THESIS, feat, sizeof feat);
+        features_describe(r->program_features &
+                              ~(VBCL_FEATURE_FRESNEL_THESIS | VBCL_FEATURE_ENVIRONMENT),
+                          feat, sizeof feat);
         fprintf(stderr,
                 "vbcl: compiling the %s kernels (%s) for %s, first time only (vbcl --warm-cache "
                 "compiles every program ahead)\n",

@@ -29,6 +29,16 @@ typedef struct ScenePattern {
     float origin[3], size[3];
 } ScenePattern;
 
+/* image.environment: a latitude-longitude image seen by rays that leave the scene
+ * (docs/scene-format.md; the kernels' VbEnvironment). file NULL: none. */
+typedef struct SceneEnvironment {
+    char *file;         /* the image, joined with the scene's directory */
+    int width, height;  /* texels */
+    float *texels;      /* linear rgba (a = 1), row 0 the top (the zenith); finite, >= 0 */
+    float scale;        /* the radiance multiplier, >= 0 */
+    float to_env[3][3]; /* rows of the world-to-environment rotation */
+} SceneEnvironment;
+
 typedef struct SceneMaterial {
     char name[SCENE_NAME_MAX];
     VbMaterial gpu;
@@ -83,6 +93,7 @@ typedef struct Scene {
     char *output;   /* image.output, or NULL */
     float exposure; /* stops */
     float background[3];
+    SceneEnvironment env; /* image.environment; env.file NULL: none */
     /* camera */
     vec3 eye, look_at, up;
     float fov; /* vertical, degrees */

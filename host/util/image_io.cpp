@@ -1,7 +1,7 @@
 // image_io.cpp — the one C++ file: OpenImageIO behind the C interface of image_io.h
-// (image_encode, image_read). image_encode has OpenImageIO write the image straight into a
-// descriptor that its caller opened (fileio.h's temporary), through an I/O proxy that
-// pwrite()s at offsets of its own. The vbcl binary loads this file as a plugin
+// (image_encode, image_read, image_read_radiance). image_encode has OpenImageIO write the
+// image straight into a descriptor that its caller opened (fileio.h's temporary), through an
+// I/O proxy that pwrite()s at offsets of its own. The vbcl binary loads this file as a plugin
 // (image_plugin.c), in its image helper process or in itself; the tests and tools link it.
 #include "image_io.h"
 
@@ -179,6 +179,80 @@ extern "C" int image_encode(const char *path, int fd, int width, int height, con
                       msg.empty() ? "the writer failed" : msg.c_str());
         return -1;
     }
+    return 0;
+}
+
+// The decoding an image's colour space calls for, by what OpenImageIO says of it: "sRGB" (PNG,
+// JPEG) the sRGB curve (DECODE_SRGB), "Rec709" (PNM) the Rec. 709 curve (DECODE_REC709),
+// "GammaCorrectedG" a power G, "Linear" (EXR, HDR) or any other name none (a power 1); an image
+// it says nothing of is sRGB when its pixels are integers, linear when they are floats.
+enum { DECODE_SRGB = -1, DECODE_REC709 = -2 };
+static float decode_power(const ImageSpec &spec)
+{
+    std::string cs = spec.get_string_attribute("oiio:ColorSpace");
+    for (char &ch : cs) ch = (char)std::tolower((unsigned char)ch);
+    if (cs.find("srgb") != std::string::npos) return DECODE_SRGB;
+    if (cs.find("rec709") != std::string::npos) return DECODE_REC709;
+    if (cs.rfind("gammacorrected", 0) == 0) {
+        float g = (float)std::atof(cs.c_str() + 14);
+        return g > 0.0f ? g : 1.0f;
+    }
+    if (cs.empty() && !spec.format.is_floating_point()) return DECODE_SRGB;
+    return 1.0f;
+}
+
+// v decoded as decode_power's p says.
+static float decode(float v, float p)
+{
+    if (p == DECODE_SRGB) return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    if (p == DECODE_REC709)
+        return v < 0.081f ? v / 4.5f : std::pow((v + 0.099f) / 1.099f, 1.0f / 0.45f);
+    return p == 1.0f || !(v > 0.0f) ? v : std::pow(v, p);
+}
+
+extern "C" int image_read_radiance(const char *path, int *width, int *height, float **rgba,
+                                   char *err, size_t errlen)
+{
+    auto in = ImageInput::open(path);
+    if (!in) {
+        std::snprintf(err, errlen, "%s: cannot read: %s", path, OIIO::geterror().c_str());
+        return -1;
+    }
+    const ImageSpec &spec = in->spec();
+    int w = spec.width, h = spec.height, nc = spec.nchannels;
+    if (w < 1 || h < 1 || nc < 1 || (size_t)w * (size_t)h > IMAGE_RADIANCE_MAX_TEXELS) {
+        std::snprintf(err, errlen, "%s: %d x %d texels: expected 1 to %zu texels", path, w, h,
+                      (size_t)IMAGE_RADIANCE_MAX_TEXELS);
+        return -1;
+    }
+    float power = decode_power(spec);
+    std::vector<float> pix;
+    try {
+        pix.resize((size_t)w * h * nc);
+    } catch (const std::bad_alloc &) {
+        std::snprintf(err, errlen, "%s: out of memory for a %dx%d image", path, w, h);
+        return -1;
+    }
+    if (!in->read_image(0, 0, 0, nc, TypeDesc::FLOAT, pix.data())) {
+        std::snprintf(err, errlen, "%s: cannot read: %s", path, in->geterror().c_str());
+        return -1;
+    }
+    in->close();
+    float *out = (float *)std::malloc(sizeof(float) * 4 * (size_t)w * h);
+    if (!out) {
+        std::snprintf(err, errlen, "%s: out of memory", path);
+        return -1;
+    }
+    int grey = nc < 3; // Y, or Y and A
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        for (int c = 0; c < 3; c++) {
+            out[4 * i + c] = decode(pix[i * nc + (grey ? 0 : c)], power);
+        }
+        out[4 * i + 3] = 1.0f;
+    }
+    *width = w;
+    *height = h;
+    *rgba = out;
     return 0;
 }
 

@@ -70,6 +70,19 @@ int image_encode(const char *path, int fd, int width, int height, const float *r
  * stored (8-bit images give encoded values in [0, 1]). *rgba is malloc'ed. */
 int image_read(const char *path, int *width, int *height, float **rgba, char *err, size_t errlen);
 
+/* The most texels image_read_radiance reads: 2^28 (16384 x 16384, 4 GiB of floats). */
+#define IMAGE_RADIANCE_MAX_TEXELS ((size_t)1 << 28)
+
+/* Reads an image as linear radiance, 4 floats per pixel (r, g, b, 1), row 0 the top: a grey
+ * image spread over r, g and b; decoded by what OpenImageIO says of its colour space: "sRGB"
+ * (PNG, JPEG) by the sRGB curve, "Rec709" (PNM) by the Rec. 709 curve, "GammaCorrectedG"
+ * raised to G, "Linear" (EXR, HDR) as stored; integer pixels of no stated colour space as
+ * sRGB, float ones as stored. Values are not checked (NaN, negative). An image of no texels
+ * or more than IMAGE_RADIANCE_MAX_TEXELS is refused. *rgba is malloc'ed. Returns 0, or -1
+ * with a message naming path. */
+int image_read_radiance(const char *path, int *width, int *height, float **rgba, char *err,
+                        size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,7 +1,7 @@
-/* image_plugin.c — image_encode and image_read of the vbcl binary, by OpenImageIO loaded
- * as a plugin. Debian's OpenImageIO brings some 260 shared libraries, whose symbols the
- * dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render pays
- * before its first ray"); linked into vbcl, every run paid that before main, `--help`
+/* image_plugin.c — image_encode, image_read and image_read_radiance of the vbcl binary, by
+ * OpenImageIO loaded as a plugin. Debian's OpenImageIO brings some 260 shared libraries,
+ * whose symbols the dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render
+ * pays before its first ray"); linked into vbcl, every run paid that before main, `--help`
  * included. Instead image_io.cpp is built into a shared object embedded in the binary
  * (vbcl_image_plugin, Makefile), loaded from an anonymous memory file (memfd_create), or
  * from an unlinked temporary file where there is none, so that the binary stays one file.
@@ -18,9 +18,9 @@
  * Loaded on a thread of this process instead, the plugin held up the kernels' build from
  * source for as long as it loaded (the dynamic loader serves one thread at a time:
  * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
- * start, with VBCL_IMAGE_HELPER=0, and for image_read (textures, before any device is
- * open), the plugin loads here, on a thread of its own (image_preload) or at the first
- * call. */
+ * start, with VBCL_IMAGE_HELPER=0, and for the reads (textures, environments; before any
+ * device is open), the plugin loads here, on a thread of its own (image_preload) or at the
+ * first call. */
 #include "image_io.h"
 
 #include "diag.h"
@@ -55,7 +55,7 @@ static pthread_cond_t plugin_loaded = PTHREAD_COND_INITIALIZER;
 static struct {
     int state; /* PLUGIN_NONE, _LOADING (on the preload thread) or _DONE (tried) */
     EncodeFn encode;
-    ReadFn read;
+    ReadFn read, read_radiance;
     char err[512]; /* why it failed */
 } plugin;
 enum { PLUGIN_NONE = 0, PLUGIN_LOADING = 1, PLUGIN_DONE = 2 };
@@ -94,7 +94,7 @@ static int plugin_file(void)
     return fd;
 }
 
-/* Loads the plugin and finds its two functions; on failure says why in plugin.err. */
+/* Loads the plugin and finds its three functions; on failure says why in plugin.err. */
 static void plugin_load(void)
 {
     int fd = plugin_file();
@@ -109,10 +109,12 @@ static void plugin_load(void)
     }
     plugin.encode = (EncodeFn)dlsym(h, "image_encode");
     plugin.read = (ReadFn)dlsym(h, "image_read");
-    if (!plugin.encode || !plugin.read) {
+    plugin.read_radiance = (ReadFn)dlsym(h, "image_read_radiance");
+    if (!plugin.encode || !plugin.read || !plugin.read_radiance) {
         snprintf(plugin.err, sizeof plugin.err, "its functions are missing");
         plugin.encode = NULL;
         plugin.read = NULL;
+        plugin.read_radiance = NULL;
     }
 }
 
@@ -440,4 +442,11 @@ int image_read(const char *path, int *width, int *height, float **rgba, char *er
 {
     if (plugin_ready(path, err, errlen)) return -1;
     return plugin.read(path, width, height, rgba, err, errlen);
+}
+
+int image_read_radiance(const char *path, int *width, int *height, float **rgba, char *err,
+                        size_t errlen)
+{
+    if (plugin_ready(path, err, errlen)) return -1;
+    return plugin.read_radiance(path, width, height, rgba, err, errlen);
 }
