@@ -9,17 +9,16 @@
  * A render that writes such an image has it encoded by a helper process: image_preload
  * starts vbcl again as `vbcl --image-helper` (image_helper_main), which loads the plugin
  * while this process opens its devices, builds its kernels and renders; image_encode sends
- * it the pixels with a copy of the descriptor of the file's temporary (SCM_RIGHTS), into
- * which the helper encodes the image, answering with the result and a message only. This
- * process made the temporary and syncs, renames or removes it (image_write.c, fileio.h), so
- * that the file's owner checks the write and no temporary outlives a failure. A helper that
- * dies, does not answer in time or is gone leaves the image to this process, which empties
- * the temporary and encodes into it itself.
- * Loaded on a thread of this process instead, the plugin held up the kernels' build from
- * source for as long as it loaded (the dynamic loader serves one thread at a time:
- * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
- * start, with VBCL_IMAGE_HELPER=0, and for the reads (textures, environments; before any
- * device is open), the plugin loads here, on a thread of its own (image_preload) or at the
+ * it the pixels in an anonymous memory file with a copy of the descriptor of the file's
+ * temporary (SCM_RIGHTS), into which the helper encodes the image, answering with the result and a
+ * message only. This process made the temporary and syncs, renames or removes it (image_write.c,
+ * fileio.h), so that the file's owner checks the write and no temporary outlives a failure. A
+ * helper that dies, does not answer in time or is gone leaves the image to this process, which
+ * empties the temporary and encodes into it itself. Loaded on a thread of this process instead, the
+ * plugin held up the kernels' build from source for as long as it loaded (the dynamic loader serves
+ * one thread at a time: docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the
+ * helper cannot start, with VBCL_IMAGE_HELPER=0, and for the reads (textures, environments; before
+ * any device is open), the plugin loads here, on a thread of its own (image_preload) or at the
  * first call. */
 #include "image_io.h"
 
@@ -164,8 +163,11 @@ static struct {
 
 /* An encoding request: the header, with the descriptor of the file to encode into attached
  * to its bytes (SCM_RIGHTS), then path_len bytes of path (whose extension names the
- * format), then width * height * 4 floats. The reply: rc (0 or -1), then err_len bytes of
- * message; the image is in the file. */
+ * format), with the descriptor of an anonymous memory file (memfd) that holds the
+ * width * height * 4 floats attached: the helper maps it, so the pixels are copied once
+ * into it and never through the socket (docs/benchmarks.md, "The image encoded into the
+ * file"). The reply: rc (0 or -1), then err_len bytes of message; the image is in the
+ * file. */
 typedef struct {
     uint32_t magic;
     int32_t width, height;
@@ -315,19 +317,41 @@ void image_preload(int thread)
 
 /* image_encode through the helper: 0, -1 with its message, or -2 when there is no helper
  * or it is gone (then the caller encodes here, the helper ended: it writes no more). */
+/* A new anonymous memory file holding the n bytes at p (close-on-exec), or -1 (no memfd,
+ * or no memory for it). */
+static int pixels_file(const void *p, size_t n)
+{
+    int fd = memfd_create("vbcl-pixels", MFD_CLOEXEC);
+    if (fd < 0) return -1;
+    const char *c = p;
+    size_t done = 0;
+    while (done < n) {
+        ssize_t k = write(fd, c + done, n - done);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) {
+            close(fd);
+            return -1;
+        }
+        done += (size_t)k;
+    }
+    return fd;
+}
+
 static int helper_encode(const char *path, int file, int width, int height, const float *rgba,
                          float exposure, char *err, size_t errlen)
 {
+    size_t plen = strlen(path), bytes = sizeof(float) * 4 * (size_t)width * (size_t)height;
+    int pixels = pixels_file(rgba, bytes);
+    if (pixels < 0) return -2; /* no room for the copy: the caller encodes here */
     pthread_mutex_lock(&helper_lock);
     int rc = -2, t = helper_timeout_ms(), s = -1;
-    size_t plen = strlen(path), bytes = sizeof(float) * 4 * (size_t)width * (size_t)height;
     HelperRequest q = {HELPER_MAGIC, width, height, exposure, (uint32_t)plen};
     HelperReply a;
     char msg[4096];
-    int pass = file; /* the copy of the file's descriptor that goes with the request */
+    int pass = file;          /* the copy of the file's descriptor that goes with the request */
+    int pixels_pass = pixels; /* and of the pixels' */
     if (helper.fd >= 0 && !(s = sock_all_within(helper.fd, &q, sizeof q, 1, t, &pass)) &&
-        !(s = sock_all_within(helper.fd, (void *)path, plen, 1, t, NULL)) &&
-        !(s = sock_all_within(helper.fd, (void *)rgba, bytes, 1, t, NULL)) &&
+        !(s = sock_all_within(helper.fd, (void *)path, plen, 1, t, &pixels_pass)) &&
         !(s = sock_all_within(helper.fd, &a, sizeof a, 0, t, NULL)) && a.err_len < sizeof msg &&
         !(s = sock_all_within(helper.fd, msg, a.err_len, 0, t, NULL))) {
         msg[a.err_len] = 0;
@@ -343,6 +367,7 @@ static int helper_encode(const char *path, int file, int width, int height, cons
     }
     int end = rc == -2 || helper.stuck;
     pthread_mutex_unlock(&helper_lock);
+    close(pixels);          /* the helper has its own copy */
     if (end) helper_stop(); /* gone or stuck: not asked again */
     return rc;
 }
@@ -378,18 +403,21 @@ int image_helper_main(void)
         }
         char path[4096], err[1024] = "";
         size_t bytes = sizeof(float) * 4 * (size_t)q.width * (size_t)q.height;
-        float *rgba = malloc(bytes);
-        if (!rgba || sock_all(HELPER_FD, path, q.path_len, 0) ||
-            sock_all(HELPER_FD, rgba, bytes, 0)) {
-            free(rgba);
+        int pixels = -1;
+        void *rgba = MAP_FAILED;
+        if (!sock_all_within(HELPER_FD, path, q.path_len, 0, -1, &pixels) && pixels >= 0 &&
+            !fstat(pixels, &st) && (size_t)st.st_size >= bytes)
+            rgba = mmap(NULL, bytes, PROT_READ, MAP_SHARED, pixels, 0);
+        if (pixels >= 0) close(pixels); /* the mapping keeps the pixels */
+        if (rgba == MAP_FAILED) {
             close(file);
-            return 1;
+            return 1; /* vbcl finds the helper gone and encodes the image itself */
         }
         path[q.path_len] = 0;
         int rc = plugin.encode ? plugin.encode(path, file, q.width, q.height, rgba, q.exposure, err,
                                                sizeof err)
                                : plugin_missing(path, err, sizeof err);
-        free(rgba);
+        munmap(rgba, bytes);
         close(file);
         HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u};
         if (sock_all(HELPER_FD, &a, sizeof a, 1) || sock_all(HELPER_FD, err, a.err_len, 1))
