@@ -406,9 +406,9 @@ static void test_faults_device_messages(void)
 
 /* The image helper stopped (SIGSTOP) while vbcl renders: vbcl waits
  * VBCL_IMAGE_HELPER_TIMEOUT seconds for it, says so, kills it and encodes the image itself
- * (today's build waited forever). A descriptor limit below the helper's socket (ulimit -n
- * 40) starts no helper, and says nothing about it (today's build printed the helper's
- * "not an option"). */
+ * (today's build waited forever); one killed during the write leaves the image to vbcl. A
+ * descriptor limit below the helper's socket (ulimit -n 40) starts no helper, and says nothing
+ * about it (today's build printed the helper's "not an option"). */
 static void test_faults_image_helper(void)
 {
     const char *scene = tu_write_file("fault_scene.json", FAULT_SCENE);
@@ -430,6 +430,26 @@ static void test_faults_image_helper(void)
     int w = 0, h = 0;
     float *pix = NULL;
     char err[512];
+    CHECK(image_read(img, &w, &h, &pix, err, sizeof err) == 0 && w == 128 && h == 128,
+          "the image is whole: %s", err);
+    free(pix);
+    /* Killed (SIGKILL) while vbcl waits for its answer: the temporary is there, vbcl finds
+     * the helper gone, empties the temporary and encodes the image itself; no temporary
+     * stays behind. */
+    snprintf(img, sizeof img, "%s/killed.png", dir);
+    snprintf(cmd, sizeof cmd,
+             "VBCL_IMAGE_HELPER_TIMEOUT=60 %s %s -q --width 128 --height 128 -o %s & p=$!; "
+             "h=; for i in $(seq 200); do h=$(pgrep -P $p); [ -n \"$h\" ] && break; sleep 0.01; "
+             "done; kill -STOP $h; t=; for i in $(seq 3000); do "
+             "t=$(ls -a %s | grep killed.png.tmp); [ -n \"$t\" ] && break; sleep 0.01; done; "
+             "[ -n \"$t\" ] || echo \"no temporary seen\"; kill -9 $h; wait $p; rc=$?; "
+             "ls -a %s | grep tmp; exit $rc",
+             tu_vbcl, scene, img, dir, dir);
+    snprintf(timed, sizeof timed, "timeout 60 bash -c '%s'", cmd);
+    rc = tu_run(timed, out, sizeof out);
+    CHECK(rc == 0 && !strstr(out, "tmp") && !strstr(out, "no temporary"),
+          "a helper killed during the write: the image encoded by vbcl, no temporary (%d): %s", rc,
+          out);
     CHECK(image_read(img, &w, &h, &pix, err, sizeof err) == 0 && w == 128 && h == 128,
           "the image is whole: %s", err);
     free(pix);
