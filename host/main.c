@@ -128,7 +128,7 @@ static const char usage_text[] =
     "      --list-devices       list OpenCL platforms and devices with their indices\n"
     "      --warm-cache         compile every kernel program for the chosen devices, all\n"
     "                           cores at once, and exit: later renders compile nothing\n"
-    "                           (make run does it first; 2 - 2.5 minutes on 2 cores)\n"
+    "                           (make run does it first; 1.5 - 2 minutes on 2 cores)\n"
     "      --stats              print rays by kind, time per stage and grid statistics\n"
     "      --stats-json FILE    write the same statistics as JSON (fields: docs/stats.md);\n"
     "                           an animation's frames go into one array, \"frames\"\n"

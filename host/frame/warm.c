@@ -106,7 +106,7 @@ int warm_cache(const char *spec, int jobs, int quiet)
     if (!quiet)
         fprintf(stderr,
                 "vbcl: warm-cache: compiling the %d kernel programs for each device, %d at a "
-                "time; 2 - 2.5 minutes on 2 cores the first time, then renders start at once\n",
+                "time; 1.5 - 2 minutes on 2 cores the first time, then renders start at once\n",
                 PROGRAM_COUNT, jobs);
     fflush(stderr);
     pid_t pid[PROGRAM_COUNT * CLU_MAX_DEVICES];
