@@ -34,16 +34,6 @@ static const char *write_exr(const char *name, int w, int h, const float *rgb)
     return path;
 }
 
-/* Renders scene (a file) into out with extra options; returns the exit status. */
-static int render(const char *scene, const char *out, const char *extra)
-{
-    char cmd[4096], log[8192];
-    snprintf(cmd, sizeof cmd, "%s %s -q -o %s %s", tu_vbcl, scene, out, extra ? extra : "");
-    int rc = tu_run(cmd, log, sizeof log);
-    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
-    return rc;
-}
-
 /* The bytes of the file at path (malloc'ed, *n of them), or NULL. */
 static unsigned char *read_bytes(const char *path, size_t *n)
 {
@@ -77,7 +67,7 @@ static void check_constant_matches(const char *name, const char *text, const cha
         snprintf(file[k], sizeof file[k], "%s_%d.json", name, k);
         snprintf(scene, sizeof scene, text, key[k]);
         snprintf(out[k], sizeof out[k], "%s/%s_%d.pfm", tu_tmpdir(), name, k);
-        if (render(tu_write_file(file[k], scene), out[k], extra)) return;
+        if (tu_render(tu_write_file(file[k], scene), out[k], extra)) return;
         b[k] = read_bytes(out[k], &n[k]);
     }
     CHECK(b[0] && b[1] && n[0] == n[1] && n[0] > 64 && memcmp(b[0], b[1], n[0]) == 0,
@@ -245,7 +235,7 @@ static int render_map(int k, const char *rotation, float **px)
              cam_fwd[k][2], cam_up[k][0], cam_up[k][1], cam_up[k][2]);
     snprintf(name, sizeof name, "map_%d.json", k);
     snprintf(out, sizeof out, "%s/map_%d.exr", tu_tmpdir(), k);
-    if (render(tu_write_file(name, text), out, NULL)) return -1;
+    if (tu_render(tu_write_file(name, text), out, NULL)) return -1;
     int w, h;
     if (image_read(out, &w, &h, px, err, sizeof err) || w != CAM_SIZE || h != CAM_SIZE) {
         CHECK(0, "%s: %s", out, err);

@@ -126,6 +126,15 @@ static void cleanup(void)
     if (device_state == 1) clu_device_close(&device);
 }
 
+int tu_render(const char *scene, const char *out, const char *extra)
+{
+    char cmd[4096], log[8192];
+    snprintf(cmd, sizeof cmd, "%s %s -q -o %s %s", tu_vbcl, scene, out, extra ? extra : "");
+    int rc = tu_run(cmd, log, sizeof log);
+    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     int jobs = 1;

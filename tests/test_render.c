@@ -10,15 +10,6 @@
 #include "image_io.h"
 #include "testutil.h"
 
-static int render(const char *scene, const char *out, const char *extra)
-{
-    char cmd[2048], log[8192];
-    snprintf(cmd, sizeof cmd, "%s %s -q -o %s %s", tu_vbcl, scene, out, extra ? extra : "");
-    int rc = tu_run(cmd, log, sizeof log);
-    CHECK(rc == 0, "%s exited %d: %s", cmd, rc, log);
-    return rc;
-}
-
 /* The floor row z = 0 under a plate that hides the light for x < 0: lit beyond the
  * penumbra, dark in the umbra, half the light at x = 0 (by symmetry), and in between
  * across |x| < R h / (H - h) = 0.25 — a soft shadow, not a hard one. */
@@ -30,7 +21,7 @@ static void test_render_penumbra_matches_geometry(void)
     }
     char out[512];
     snprintf(out, sizeof out, "%s/penumbra.exr", tu_tmpdir());
-    if (render("tests/scenes/penumbra.json", out, NULL)) return;
+    if (tu_render("tests/scenes/penumbra.json", out, NULL)) return;
     int w, h;
     float *px;
     char err[512];
@@ -125,7 +116,7 @@ static void test_render_penumbra_feelers(void)
         char out[512], args[160], err[512];
         snprintf(out, sizeof out, "%s/penumbra_k%d.exr", tu_tmpdir(), i);
         snprintf(args, sizeof args, "--width 303 --height 33 %s", extra[i]);
-        if (render("tests/scenes/penumbra.json", out, args)) goto done;
+        if (tu_render("tests/scenes/penumbra.json", out, args)) goto done;
         if (image_read(out, &w, &h, &img[i], err, sizeof err)) {
             CHECK(0, "%s", err);
             goto done;
@@ -189,7 +180,7 @@ static void test_render_quickstart_reference(void)
     }
     char out[512], cmd[2048], log[8192];
     snprintf(out, sizeof out, "%s/quickstart_100.png", tu_tmpdir());
-    if (render("scenes/quickstart.json", out, "--width 100 --height 100")) return;
+    if (tu_render("scenes/quickstart.json", out, "--width 100 --height 100")) return;
     int w, h;
     float *px;
     char err[512];
@@ -259,7 +250,7 @@ static void test_render_quickstart_soft_shadow(void)
         char out[512], err[512];
         if (!scenes[i]) return;
         snprintf(out, sizeof out, "%s/qs_%s.exr", tu_tmpdir(), names[i]);
-        if (render(scenes[i], out, "--width 100 --height 100 --shadow-samples 64")) return;
+        if (tu_render(scenes[i], out, "--width 100 --height 100 --shadow-samples 64")) return;
         if (image_read(out, &w, &h, &img[i], err, sizeof err)) {
             CHECK(0, "%s", err);
             return;
@@ -315,7 +306,7 @@ static void test_render_texture_outside_host_casts_no_shadow(void)
         snprintf(text, sizeof text, "%s%s}]}", head, i ? tex : "");
         const char *scene = tu_write_file(i ? "carved.json" : "plain.json", text);
         snprintf(out[i], sizeof out[i], "%s/carved_%d.exr", tu_tmpdir(), i);
-        if (!scene || render(scene, out[i], NULL)) return;
+        if (!scene || tu_render(scene, out[i], NULL)) return;
         if (image_read(out[i], &w, &h, &img[i], err, sizeof err)) {
             CHECK(0, "%s", err);
             free(img[0]);

@@ -16,6 +16,9 @@ VbDevice *tu_device(void);
 /* Runs a shell command, capturing stdout and stderr together into out (may be NULL).
  * Returns the exit status, or -1 if it could not run. */
 int tu_run(const char *cmd, char *out, size_t outlen);
+/* Renders scene (a file) into out with extra options (or NULL), quietly; a failed check
+ * unless it exits 0. Returns the exit status. */
+int tu_render(const char *scene, const char *out, const char *extra);
 
 /* A fresh temporary directory for this test run (created once, removed at exit). */
 const char *tu_tmpdir(void);

@@ -210,8 +210,12 @@ static float decode(float v, float p)
     return p == 1.0f || !(v > 0.0f) ? v : std::pow(v, p);
 }
 
-extern "C" int image_read_radiance(const char *path, int *width, int *height, float **rgba,
-                                   char *err, size_t errlen)
+// Reads the image at path as floats, nc channels a pixel, into a new RGBA buffer of its
+// w * h pixels (*rgba, malloc'ed) that fill(spec, pixels, nc, rgba, w * h) fills: 0, or -1
+// with a message naming path in err. max_texels, where not 0, bounds w * h.
+template <typename Fill>
+static int read_rgba(const char *path, size_t max_texels, int *width, int *height, float **rgba,
+                     char *err, size_t errlen, Fill fill)
 {
     auto in = ImageInput::open(path);
     if (!in) {
@@ -220,12 +224,11 @@ extern "C" int image_read_radiance(const char *path, int *width, int *height, fl
     }
     const ImageSpec &spec = in->spec();
     int w = spec.width, h = spec.height, nc = spec.nchannels;
-    if (w < 1 || h < 1 || nc < 1 || (size_t)w * (size_t)h > IMAGE_RADIANCE_MAX_TEXELS) {
+    if (max_texels && (w < 1 || h < 1 || nc < 1 || (size_t)w * (size_t)h > max_texels)) {
         std::snprintf(err, errlen, "%s: %d x %d texels: expected 1 to %zu texels", path, w, h,
-                      (size_t)IMAGE_RADIANCE_MAX_TEXELS);
+                      max_texels);
         return -1;
     }
-    float power = decode_power(spec);
     std::vector<float> pix;
     try {
         pix.resize((size_t)w * h * nc);
@@ -243,45 +246,35 @@ extern "C" int image_read_radiance(const char *path, int *width, int *height, fl
         std::snprintf(err, errlen, "%s: out of memory", path);
         return -1;
     }
-    int grey = nc < 3; // Y, or Y and A
-    for (size_t i = 0; i < (size_t)w * h; i++) {
-        for (int c = 0; c < 3; c++) {
-            out[4 * i + c] = decode(pix[i * nc + (grey ? 0 : c)], power);
-        }
-        out[4 * i + 3] = 1.0f;
-    }
+    fill(spec, pix.data(), nc, out, (size_t)w * h);
     *width = w;
     *height = h;
     *rgba = out;
     return 0;
 }
 
+extern "C" int image_read_radiance(const char *path, int *width, int *height, float **rgba,
+                                   char *err, size_t errlen)
+{
+    return read_rgba(path, IMAGE_RADIANCE_MAX_TEXELS, width, height, rgba, err, errlen,
+                     [](const ImageSpec &spec, const float *pix, int nc, float *out, size_t n) {
+                         float power = decode_power(spec);
+                         int grey = nc < 3; // Y, or Y and A
+                         for (size_t i = 0; i < n; i++) {
+                             for (int c = 0; c < 3; c++)
+                                 out[4 * i + c] = decode(pix[i * nc + (grey ? 0 : c)], power);
+                             out[4 * i + 3] = 1.0f;
+                         }
+                     });
+}
+
 extern "C" int image_read(const char *path, int *width, int *height, float **rgba, char *err,
                           size_t errlen)
 {
-    auto in = ImageInput::open(path);
-    if (!in) {
-        std::snprintf(err, errlen, "%s: cannot read: %s", path, OIIO::geterror().c_str());
-        return -1;
-    }
-    const ImageSpec &spec = in->spec();
-    int w = spec.width, h = spec.height, nc = spec.nchannels;
-    std::vector<float> pix((size_t)w * h * nc);
-    if (!in->read_image(0, 0, 0, nc, TypeDesc::FLOAT, pix.data())) {
-        std::snprintf(err, errlen, "%s: cannot read: %s", path, in->geterror().c_str());
-        return -1;
-    }
-    in->close();
-    float *out = (float *)std::malloc(sizeof(float) * 4 * (size_t)w * h);
-    if (!out) {
-        std::snprintf(err, errlen, "%s: out of memory", path);
-        return -1;
-    }
-    for (size_t i = 0; i < (size_t)w * h; i++)
-        for (int c = 0; c < 4; c++)
-            out[4 * i + c] = c < nc ? pix[i * nc + c] : (c == 3 ? 1.0f : 0.0f);
-    *width = w;
-    *height = h;
-    *rgba = out;
-    return 0;
+    return read_rgba(path, 0, width, height, rgba, err, errlen,
+                     [](const ImageSpec &, const float *pix, int nc, float *out, size_t n) {
+                         for (size_t i = 0; i < n; i++)
+                             for (int c = 0; c < 4; c++)
+                                 out[4 * i + c] = c < nc ? pix[i * nc + c] : (c == 3 ? 1.0f : 0.0f);
+                     });
 }
