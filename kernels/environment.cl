@@ -10,10 +10,11 @@
 /* The environment's radiance along dir (any length but 0; world space), bilinear: along u
  * between texel centres, wrapping across the seam at u = 0 (the direction -z of the
  * environment), along v between rows, row 0 at v = 0 (its +y, the zenith) and the last at
- * v = 1; the texels hold the image times its scale. Kept out of line: only rays that leave
- * the scene call it, and the tracing loops around its callers stay as small as without it. */
-__attribute__((noinline)) float3 environment_radiance(__constant const VbEnvironment *e,
-                                                      __global const float *texels, float3 dir)
+ * v = 1; the texels hold the image times its scale. Inlined like every helper: kept out of
+ * line (noinline), Intel's CPU OpenCL runtime looked up the wrong texels (values 1 to 3 floats
+ * off, and up to 1e30), while PoCL rendered it right (docs/architecture.md). */
+VB_INLINE float3 environment_radiance(__constant const VbEnvironment *e,
+                                      __global const float *texels, float3 dir)
 {
     float3 d = (float3)(dot(vb_cload3(e->rot[0]), dir), dot(vb_cload3(e->rot[1]), dir),
                         dot(vb_cload3(e->rot[2]), dir));

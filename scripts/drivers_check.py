@@ -59,6 +59,8 @@ SCENES = [
     ("prism_dispersion 96x64", "scenes/prism_dispersion.json",
      ["--width", "96", "--height", "64"], "glass", 0),
     ("high_index 64x64", "scenes/high_index.json", SMALL + ["--shadow-samples", "4"], "glass", 0),
+    ("environment_glass 64x64", "scenes/environment_glass.json",
+     SMALL + ["--shadow-samples", "4"], "glass", 0),
     # one frame shared by both drivers (--device A,B): a mixture of their pixels
     ("quickstart 64x64 on both at once", "scenes/quickstart.json", SMALL + ["MIXED"], "opaque",
      0),
