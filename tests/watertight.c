@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "offset.h"
 #include "render.h"
 #include "scene.h"
 
@@ -75,22 +76,6 @@ static D3 rng_direction(uint64_t *s)
         double l2 = d3_dot(v, v);
         if (l2 > 1e-6 && l2 <= 1.0) return d3_mul(v, 1.0 / sqrt(l2));
     }
-}
-
-/* ray_offset_origin of kernels/geometry.cl, ported to the host operation by operation
- * (convert_int rounds toward zero, as a C cast does; no contraction on either side):
- * the per-component rule, then the floor of about 16 ulps of the triangle's scale. */
-static float offset_component(float p, float n)
-{
-    const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-    int of_i = (int)(int_scale * n);
-    int32_t bits;
-    memcpy(&bits, &p, sizeof bits);
-    bits += p < 0.0f ? -of_i : of_i;
-    float p_i;
-    memcpy(&p_i, &bits, sizeof p_i);
-    float p_f = p + float_scale * n;
-    return fabsf(p) < origin ? p_f : p_i;
 }
 
 /* The triangle's unit normal as tri_normal computes it, in float. */
@@ -400,16 +385,13 @@ static unsigned long long check_aimed(const Mesh *m, const D3 *normals, const Vb
         vec3 ng = tri_normal_f(m, t);
         float side = v3_dot(ng, v3((float)dir.x, (float)dir.y, (float)dir.z)) < 0.0f ? 1.0f : -1.0f;
         vec3 nf = v3_scale(ng, side);
-        vec3 q = v3(offset_component(p.x, nf.x), offset_component(p.y, nf.y),
-                    offset_component(p.z, nf.z));
-        float scale = 0.0f;
-        for (int k = 0; k < 3; k++) {
-            vec3 v = k == 0 ? a : k == 1 ? b : c;
-            scale = fmaxf(scale, fmaxf(fabsf(v.x), fmaxf(fabsf(v.y), fabsf(v.z))));
-        }
-        float need = scale * (1.0f / 1048576.0f);
-        vec3 dq = v3_sub(q, p);
-        if (!(dq.x * nf.x + dq.y * nf.y + dq.z * nf.z >= need)) q = v3_add(p, v3_scale(nf, need));
+        /* ray_offset_origin with tri_point_error (kernels/geometry.cl), from offset.h, the
+         * kernels' own arithmetic */
+        float err = vb_offset_error(ng.x, ng.y, ng.z, vb_offset_sum(w0, h->u, h->v, a.x, b.x, c.x),
+                                    vb_offset_sum(w0, h->u, h->v, a.y, b.y, c.y),
+                                    vb_offset_sum(w0, h->u, h->v, a.z, b.z, c.z));
+        vec3 q = v3(vb_offset_coord(p.x, nf.x, err), vb_offset_coord(p.y, nf.y, err),
+                    vb_offset_coord(p.z, nf.z, err));
         D3 org = d3(q.x, q.y, q.z);
         D3 hemi = rng_direction(rng);
         if (d3_dot(hemi, d3_of(nf)) < 0) hemi = d3_mul(hemi, -1);
