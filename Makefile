@@ -288,7 +288,7 @@ FUZZ_TARGETS := scene mesh_obj mesh_ply
 FUZZ_SRC     := $(wildcard host/scene/*.c) host/util/diag.c host/geom/mesh.c host/geom/mesh_meet.c \
                 host/geom/mesh_io.c host/geom/shapes.c host/accel/grid.c host/util/cache.c \
                 host/texgen/texgen_args.c host/texgen/texgen_bomb.c host/texgen/texgen_deform.c \
-                host/texgen/texgen_set.c host/util/fileio.c
+                host/texgen/texgen_set.c host/util/fileio.c tests/fuzz/no_images.c
 build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_input.h $(FUZZ_SRC) build/config.mk | test-deps
 	@mkdir -p $(dir $@)
 	@echo "  FUZZ    $@"
@@ -327,4 +327,4 @@ format-check:
 clean:
 	rm -rf build vbcl
 
--include $(shell find build -name '*.d' 2>/dev/null)
+-include $(shell find build $(BUILD) -name '*.d' 2>/dev/null | sort -u)

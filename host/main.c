@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "aa.h"
+#include "aa_map.h"
 #include "frame.h"
 #include "clu.h"
 #include "diag.h"
@@ -52,6 +53,18 @@ static const char usage_text[] =
     "                           default: all of them\n"
     "      --width N            image width in pixels (1..16384)\n"
     "      --height N           image height in pixels (1..16384)\n"
+    "      --crop X0,Y0,X1,Y1   render and write only this region of the image, its pixels\n"
+    "                           the whole image's bit for bit: whole pixels (X0,Y0 its top-\n"
+    "                           left pixel, 0,0 the image's; X1,Y1 one past its right column\n"
+    "                           and bottom row), or fractions of the image from 0 to 1 with\n"
+    "                           a decimal point, each bound rounded up to a pixel as pbrt's\n"
+    "                           crop window (0.25,0.25,0.75,0.5; pbrt's --cropwindow lists\n"
+    "                           them as X0,X1,Y0,Y1)\n"
+    "      --crop-margin N      with --aa, the pixels rendered around the region for its\n"
+    "                           contrast test (default: the refinement's whole reach, 257\n"
+    "                           less --aa-min-level); a smaller margin is faster, and the\n"
+    "                           region stays the whole image's while both refine in fewer\n"
+    "                           than N rounds (--stats)\n"
     "      --grid TOP[:SUB]     two-level grid: TOP, the top level, is auto, N or X,Y,Z\n"
     "                           (1..1024 per axis, at most 134217728 cells in all; default\n"
     "                           auto); SUB, the sub-grid in each crowded top cell, is auto\n"
@@ -102,9 +115,13 @@ static const char usage_text[] =
     "                           thesis's per-channel rays (1 red, 2 green, 3 blue)\n"
     "      --ssaa N             uniform N x N supersampling of every pixel (1..16)\n"
     "      --aa-map FILE        write each pixel's deepest refinement level as a heat map\n"
-    "                           (dark 0, blue 1, green 2, yellow 3, red 4)\n"
+    "                           (dark 0, blue 1, green 2, yellow 3, red 4), a legend of\n"
+    "                           the levels' colours and numbers to its right (the map\n"
+    "                           stays the image's top-left WIDTH x HEIGHT pixels); frames\n"
+    "                           are numbered as with -o\n"
     "      --aa-samples-map FILE  write each pixel's number of samples as a heat map on the\n"
-    "                           same colours (dark 1, blue 4, green 16, yellow 64, red 256)\n"
+    "                           same colours (dark 1, blue 4, green 16, yellow 64, red\n"
+    "                           256), its legend a colour bar marked 1, 4, 16, 64, 256\n"
     "      --device INDEX|NAME|all|LIST  OpenCL device (also VBCL_DEVICE; default: device 0);\n"
     "                           all, or a list such as 0,2 or pocl,intel, shares pass 0's\n"
     "                           tiles among several (refinement runs on the first)\n"
@@ -140,6 +157,10 @@ typedef struct Options {
     const char *scene, *output, *device, *grid, *fresnel, *aa_reconstruct, *aa_pairs, *aa_map,
         *aa_samples_map, *stats_json;
     int frame_first, frame_last; /* --frames; -1: not given */
+    const char *crop;            /* --crop as given, or NULL */
+    double crop_v[4];            /* its four numbers */
+    int crop_fraction;           /* 1: fractions of the image, 0: pixels */
+    int crop_margin;             /* --crop-margin; -1: not given */
     int width, height, shadow_samples, depth, aa_max_level, aa_min_level, ssaa, bands, seed;
     double grid_density, subgrid_density, exposure, min_weight, aa, aa_floor, aa_level_gain;
     int have_exposure;
@@ -215,6 +236,7 @@ static const OptionSpec option_specs[] = {
     {"--aa-floor", NULL, OPT_DOUBLE, offsetof(Options, aa_floor), 0, 2},
     {"--aa-level-gain", NULL, OPT_DOUBLE, offsetof(Options, aa_level_gain), 1, 4},
     {"--ssaa", NULL, OPT_INT, offsetof(Options, ssaa), 1, 16},
+    {"--crop-margin", NULL, OPT_INT, offsetof(Options, crop_margin), 0, SCENE_MAX_IMAGE},
     {"--aa-map", NULL, OPT_STRING, offsetof(Options, aa_map), 0, 0},
     {"--aa-samples-map", NULL, OPT_STRING, offsetof(Options, aa_samples_map), 0, 0},
     {"--device", NULL, OPT_STRING, offsetof(Options, device), 0, 0},
@@ -277,12 +299,54 @@ static int option_frames(Options *o, const char *val)
     return -1;
 }
 
+/* What --crop takes, for its messages. */
+#define CROP_EXPECTED                                                                              \
+    "expected X0,Y0,X1,Y1: four whole numbers of pixels (X0,Y0 the region's top-left pixel, "      \
+    "X1,Y1 one past its right column and bottom row) or four fractions of the image from 0 to 1 "  \
+    "with a decimal point (0.25,0.25,0.75,0.5)"
+
+/* --crop X0,Y0,X1,Y1: four whole numbers (pixels) or four numbers with a decimal point
+ * (fractions of the image), a non-empty region with X0 < X1 and Y0 < Y1; checked against
+ * the image by crop_apply. Returns -1 or 2. */
+static int option_crop(Options *o, const char *val)
+{
+    const char *p = val;
+    int points = 0;
+    for (int k = 0; k < 4; k++) {
+        char *end;
+        const char *dot = p + strcspn(p, ",");
+        int fraction = memchr(p, '.', (size_t)(dot - p)) != NULL;
+        errno = 0;
+        double v = fraction ? (double)strtof(p, &end) : (double)strtol(p, &end, 10);
+        if (end == p || end != dot || (k < 3) != (*end == ',') || errno || !isfinite(v) ||
+            (k > 0 && fraction != points))
+            return usage_error("--crop %s: " CROP_EXPECTED, diag_value(val));
+        if (v < 0.0 || (fraction && v > 1.0))
+            return usage_error("--crop %s: %s%d = %s lies outside the image (%s)", diag_value(val),
+                               k % 2 ? "Y" : "X", k / 2, diag_num(v),
+                               fraction ? "a fraction of it is from 0 to 1"
+                                        : "pixels count from 0 at its top-left corner");
+        points = fraction;
+        o->crop_v[k] = v;
+        p = end + (k < 3);
+    }
+    for (int k = 0; k < 2; k++)
+        if (!(o->crop_v[k] < o->crop_v[k + 2]))
+            return usage_error("--crop %s: an empty region: %s1 = %s must be greater than %s0 = %s",
+                               diag_value(val), k ? "Y" : "X", diag_num(o->crop_v[k + 2]),
+                               k ? "Y" : "X", diag_num(o->crop_v[k]));
+    o->crop = val;
+    o->crop_fraction = points;
+    return -1;
+}
+
 /* The options with a value that need more than a range: --frames, --fresnel, --exposure,
- * --bands, --aa-reconstruct, --aa-pairs. Returns -1 (stored), 2 (usage error) or -2 (a is none of
- * them). */
+ * --bands, --aa-reconstruct, --aa-pairs, --crop. Returns -1 (stored), 2 (usage error) or -2 (a
+ * is none of them). */
 static int option_special(Options *o, const char *a, const char *val)
 {
     if (!strcmp(a, "--frames")) return option_frames(o, val);
+    if (!strcmp(a, "--crop")) return option_crop(o, val);
     if (!strcmp(a, "--fresnel")) {
         if (strcmp(val, "exact") && strcmp(val, "thesis"))
             return usage_error("--fresnel %s: expected exact or thesis", diag_value(val));
@@ -316,8 +380,8 @@ static int option_special(Options *o, const char *a, const char *val)
 }
 
 /* The options option_special reads. */
-static const char *const special_options[] = {"--frames", "--fresnel",        "--exposure",
-                                              "--bands",  "--aa-reconstruct", "--aa-pairs"};
+static const char *const special_options[] = {
+    "--frames", "--fresnel", "--exposure", "--bands", "--aa-reconstruct", "--aa-pairs", "--crop"};
 
 static int is_special_option(const char *a)
 {
@@ -352,7 +416,7 @@ static int parse_args(int argc, char **argv, Options *o)
     o->grid_density = o->subgrid_density = o->min_weight = o->aa = o->aa_floor = -1;
     o->aa_level_gain = -1;
     o->aa_max_level = o->aa_min_level = o->ssaa = o->bands = o->seed = -1;
-    o->frame_first = o->frame_last = -1;
+    o->frame_first = o->frame_last = o->crop_margin = -1;
     static char named[64]; /* the option of an --option=value, without its value */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -461,27 +525,58 @@ static int needs_image_library(const Options *o, const Scene *s)
            (o->aa_samples_map && !image_is_native_format(o->aa_samples_map));
 }
 
-/* Writes each pixel's refinement level (aa_level_colour) or, with samples set, its number
- * of samples (aa_samples_colour) as a heat map. */
-static int write_aa_map(const char *path, const Scene *s, const int *values, int samples, char *err,
-                        size_t errlen)
+/* The number of pixels in the rectangle r (x0, y0, x1, y1: frame_region, frame_window). */
+static size_t rect_pixels(const int r[4])
 {
-    size_t npix = (size_t)s->width * (size_t)s->height;
-    float *map = malloc(sizeof(float) * 4 * npix);
+    return (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
+}
+
+/* Writes each pixel's refinement level or, with samples set, its number of samples of the
+ * region reg as a heat map with its legend to the right (aa_map_image: the map stays the
+ * image's top-left pixels, the region's size). */
+static int write_aa_map(const char *path, const Scene *s, const int reg[4], const int *values,
+                        int samples, char *err, size_t errlen)
+{
+    AaMapLegend lg;
+    float *map =
+        aa_map_image(values, reg[2] - reg[0], reg[3] - reg[1], samples, s->aa_max_level, &lg);
     if (!map) {
         snprintf(err, errlen, "out of memory for the anti-aliasing map");
         return -1;
     }
-    for (size_t i = 0; i < npix; i++) {
-        if (samples)
-            aa_samples_colour(values[i], map + 4 * i);
-        else
-            aa_level_colour(values[i], map + 4 * i);
-        map[4 * i + 3] = 1.0f;
-    }
-    int rc = image_write(path, s->width, s->height, map, 0.0f, err, errlen);
+    int rc = image_write(path, lg.width, lg.height, map, 0.0f, err, errlen);
     free(map);
     return rc;
+}
+
+/* --crop on s's image, into s->crop: pixels as given, or fractions rounded as pbrt-v4 rounds
+ * its crop window, each bound up to a whole pixel in single precision (x0 = ceilf(width *
+ * X0), ...); and --crop-margin. Returns 0, or 2 after a usage error. */
+static int crop_apply(const Options *o, Scene *s)
+{
+    if (o->crop_margin >= 0 && (!o->crop || aa_reach(s) == 0))
+        return usage_error("--crop-margin %d: needs --crop and adaptive anti-aliasing (--aa or "
+                           "render.aa), whose contrast test reads the pixels around the region",
+                           o->crop_margin);
+    if (!o->crop) return 0;
+    int size[2] = {s->width, s->height};
+    for (int k = 0; k < 4; k++) {
+        double v = o->crop_fraction ? (double)ceilf((float)size[k % 2] * (float)o->crop_v[k])
+                                    : o->crop_v[k];
+        if (v > size[k % 2])
+            return usage_error("--crop %s: %s%d = %s lies outside the %dx%d image (%s at most %d)",
+                               diag_value(o->crop), k % 2 ? "Y" : "X", k / 2, diag_num(v), s->width,
+                               s->height, k % 2 ? "Y" : "X", size[k % 2]);
+        s->crop[k] = (int)v;
+    }
+    if (s->crop[0] >= s->crop[2] || s->crop[1] >= s->crop[3])
+        return usage_error("--crop %s: rounds to no pixel of the %dx%d image (x %d to %d, y %d to "
+                           "%d: width x fraction and height x fraction rounded up, as pbrt's crop "
+                           "window)",
+                           diag_value(o->crop), s->width, s->height, s->crop[0], s->crop[2],
+                           s->crop[1], s->crop[3]);
+    s->crop_margin = o->crop_margin;
+    return 0;
 }
 
 /* The command line's settings over the scene's own. Returns 0, or 2 after a usage error. */
@@ -536,7 +631,7 @@ static int apply_options(const Options *o, Scene *s)
         return usage_error("--grid %s: expected TOP or TOP:SUB, each auto, N or NX,NY,NZ (TOP "
                            "1..1024 each, at most 2^27 = 134217728 cells in all; SUB 1..64 each)",
                            diag_value(o->grid));
-    return 0;
+    return crop_apply(o, s);
 }
 
 /* Reports a frame written to out: --stats on stderr; with --stats-json its object added to
@@ -590,8 +685,10 @@ static int report_frame(const Options *o, const StatsFrame *fr, const char *out,
         if (fr->nwork > ndevices) /* ranks that share a device */
             snprintf(on + strlen(on), sizeof on - strlen(on), ", %d queues", fr->nwork);
         if (mpi_rank >= 0) snprintf(on + strlen(on), sizeof on - strlen(on), ", rank %d", mpi_rank);
+        int reg[4];
+        frame_region(s, reg);
         printf("vbcl: wrote %s (%dx%d) in %.2f s: %u triangles, %llu rays (%.2f Mrays/s) on %s\n",
-               out, s->width, s->height, fr->total_ms / 1000.0, s->mesh.ntris, rays,
+               out, reg[2] - reg[0], reg[3] - reg[1], fr->total_ms / 1000.0, s->mesh.ntris, rays,
                render_ms > 0 ? (double)rays / (render_ms * 1e3) : 0.0, on);
         fflush(stdout);
     }
@@ -627,7 +724,9 @@ static int render_image(const Options *o, const Scene *s, VbDevice *devs, int nd
                         int max, double *image_wait_ms)
 {
     char err[1024] = "";
-    long npix = (long)s->width * s->height;
+    int win[4];
+    frame_window(s, win);
+    long npix = (long)rect_pixels(win);
     int shared = d && d->size > 1;
     TileSource src;
     /* the image library first: without the helper process it loads on a thread of vbcl,
@@ -675,12 +774,16 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
     char *out = output_path(o, &s, frame);
     char *map = !o->aa_map ? NULL : frame_path(o->aa_map, frame);
     char *smap = !o->aa_samples_map ? NULL : frame_path(o->aa_samples_map, frame);
-    float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
+    int win[4], reg[4]; /* the pixels rendered, and those written */
+    frame_window(&s, win);
+    frame_region(&s, reg);
+    float *rgba = malloc(sizeof(float) * 4 * rect_pixels(win));
     DeviceWork *work = calloc((size_t)max, sizeof *work);
     RenderStats st;
     memset(&st, 0, sizeof st);
     if (!out || (o->aa_map && !map) || (o->aa_samples_map && !smap) || !rgba || !work) {
-        fprintf(stderr, "%s: out of memory for a %dx%d image\n", prog, s.width, s.height);
+        fprintf(stderr, "%s: out of memory for a %dx%d image\n", prog, win[2] - win[0],
+                win[3] - win[1]);
         rc = 1;
         dist_abort(d, 1); /* with other ranks: they wait for tiles */
         goto done;
@@ -689,10 +792,11 @@ static int render_frame(const Options *o, Scene *scene, int frame, VbDevice *dev
     rc = render_image(o, &s, devs, ndev, d, fr, rgba, &st, work, &nwork, max, &image_wait_ms);
     if (rc) goto done;
     double tw = clu_now_ms();
-    if (image_write(out, s.width, s.height, rgba, s.exposure, err, sizeof err) ||
-        (map && frame_levels(fr) && write_aa_map(map, &s, frame_levels(fr), 0, err, sizeof err)) ||
+    if (image_write(out, reg[2] - reg[0], reg[3] - reg[1], rgba, s.exposure, err, sizeof err) ||
+        (map && frame_levels(fr) &&
+         write_aa_map(map, &s, reg, frame_levels(fr), 0, err, sizeof err)) ||
         (smap && frame_leaves(fr) &&
-         write_aa_map(smap, &s, frame_leaves(fr), 1, err, sizeof err))) {
+         write_aa_map(smap, &s, reg, frame_leaves(fr), 1, err, sizeof err))) {
         diag_print(prog, "%s", err);
         rc = 1;
         goto done;
@@ -718,21 +822,24 @@ static int render_tiles_for_rank0(Dist *d, Scene *scene, VbDevice *devs, int nde
 {
     char err[1024] = "";
     Scene s = *scene;
-    float *rgba = malloc(sizeof(float) * 4 * (size_t)s.width * (size_t)s.height);
+    int win[4]; /* the pixels rendered: rank 0's tiles count them */
+    frame_window(&s, win);
+    float *rgba = malloc(sizeof(float) * 4 * rect_pixels(win));
     Frame fr;
     memset(&fr, 0, sizeof fr);
     RenderStats st;
     memset(&st, 0, sizeof st);
     TileSource src;
-    dist_tiles_begin(d, rgba, (long)s.width * s.height, 0, &src, err, sizeof err);
+    dist_tiles_begin(d, rgba, (long)rect_pixels(win), 0, &src, err, sizeof err);
     int rc = 1;
     if (!rgba)
-        snprintf(err, sizeof err, "cannot allocate a %dx%d image", s.width, s.height);
+        snprintf(err, sizeof err, "cannot allocate a %dx%d image", win[2] - win[0],
+                 win[3] - win[1]);
     else
         rc = frame_init(&fr, devs, ndev, &s, &st, err, sizeof err);
     if (!rc) {
         fr.tiles = &src;
-        rc = frame_pixel_centres(&fr, &s, rgba, &st, 0, err, sizeof err);
+        rc = frame_pixel_centres(&fr, rgba, &st, 0, err, sizeof err);
     }
     if (dist_tiles_report(d, rc, err, &st, fr.work, frame_devices(&fr))) rc = 1;
     frame_release(&fr);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "fileio.h"
+#include "frame.h"
 #include "kernel_features.h"
 
 unsigned long long stats_rays_total(const RenderStats *st)
@@ -41,6 +42,7 @@ enum {
     W_PENUMBRA = 1u << 6,     /* points in a penumbra trace more feelers */
     W_UNIFORM = 1u << 7,      /* --ssaa */
     W_ADAPTIVE = 1u << 8,     /* --aa */
+    W_CROP = 1u << 9,         /* --crop */
 };
 
 /* What a frame's fields are read from: its records, or StatsDerived. */
@@ -63,6 +65,8 @@ enum {
     T_RESOLUTION, /* the grid's top cells per axis */
     T_BY_DEPTH,   /* rays by ray-tree depth */
     T_REFINED,    /* pixels refined per anti-aliasing level */
+    T_REGION,     /* the pixels written (frame_region): x0, y0, x1, y1 */
+    T_WINDOW,     /* the pixels rendered (frame_window): x0, y0, x1, y1 */
     T_COUNTERS,   /* the group's counters in VBCL_COUNTER_LIST: JSON only */
 };
 
@@ -108,6 +112,11 @@ typedef struct StatsDerived {
     int ssaa, aa_max_level, aa_min_level;
     float aa_threshold, aa_floor, aa_level_gain; /* 0 unless adaptive */
     double kernel_ms, mrays_per_s;
+    bool cropped;             /* --crop */
+    int region[4], window[4]; /* the pixels written and rendered, x0, y0, x1, y1 */
+    int region_w, region_h;   /* the image written */
+    int margin;               /* pixels rendered around the region, where the image has them */
+    unsigned long long window_pixels;
 } StatsDerived;
 
 /* The T_* of a field, from its declaration: a char array and a char pointer decay alike,
@@ -155,6 +164,16 @@ static const StatsField stats_fields[] = {
     {FIELD("scene", "lights", SC(nlights), ", %lld lights")},
     {JSON("scene", "width", SC(width))},
     {JSON("scene", "height", SC(height))},
+    LINE(W_CROP),
+    {JSON("crop", "cropped", DR(cropped))},
+    {FIELD("crop", "region", SPECIAL(T_REGION), "crop        region %lld,%lld to %lld,%lld")},
+    {FIELD("crop", "width", DR(region_w), " (%lldx")},
+    {FIELD("crop", "height", DR(region_h), "%lld of")},
+    {TEXT(SC(width), " %lldx")},
+    {TEXT(SC(height), "%lld)")},
+    {FIELD("crop", "margin", DR(margin), ", margin %lld")},
+    {FIELD("crop", "window", SPECIAL(T_WINDOW), ": rendered %lld,%lld to %lld,%lld")},
+    {FIELD("crop", "window_pixels", DR(window_pixels), " (%lld pixels)")},
     LINE(0),
     {FIELD("device", "name", DV(name), "device      %s")},
     {FIELD("device", "version", DV(version), " (%s)")},
@@ -345,6 +364,7 @@ static unsigned stats_when(const StatsFrame *fr, int adaptive)
     if (penumbra_factor(fr) > 1u) w |= W_PENUMBRA;
     if (s->ssaa > 1) w |= W_UNIFORM;
     if (adaptive) w |= W_ADAPTIVE;
+    if (s->crop[2] > 0) w |= W_CROP;
     return w;
 }
 
@@ -357,7 +377,12 @@ static void stats_derive(const StatsFrame *fr, StatsDerived *v)
     const Grid *g = &fr->r->cs->grid;
     unsigned strata = fr->r->frame_host.shadow_strata;
     unsigned long long total = stats_rays_total(st);
-    double npix = (double)s->width * (double)s->height, kernel_ms = stats_kernel_ms(st);
+    int reg[4], win[4];
+    frame_region(s, reg);
+    frame_window(s, win);
+    unsigned long long window_pixels =
+        (unsigned long long)(win[2] - win[0]) * (unsigned long long)(win[3] - win[1]);
+    double npix = (double)window_pixels, kernel_ms = stats_kernel_ms(st);
     int adaptive = s->ssaa <= 1 && s->aa_threshold > 0.0f;
     *v = (StatsDerived){
         .when = stats_when(fr, adaptive),
@@ -392,6 +417,13 @@ static void stats_derive(const StatsFrame *fr, StatsDerived *v)
         .aa_level_gain = adaptive ? s->aa_level_gain : 0.0f,
         .kernel_ms = kernel_ms,
         .mrays_per_s = kernel_ms > 0 ? (double)total / (kernel_ms * 1e3) : 0.0,
+        .cropped = s->crop[2] > 0,
+        .region = {reg[0], reg[1], reg[2], reg[3]},
+        .window = {win[0], win[1], win[2], win[3]},
+        .region_w = reg[2] - reg[0],
+        .region_h = reg[3] - reg[1],
+        .margin = frame_margin(s),
+        .window_pixels = window_pixels,
     };
 }
 
@@ -450,10 +482,12 @@ static StatsValue stats_read(const StatsSources *c, const StatsAt *at)
 /* The text of the fields that are not one number or name. The lists (by depth, refined per
  * level) are as long as the frame makes them, so their items' words are here, not in
  * the table. */
-static void print_special(FILE *f, const StatsField *r, const StatsFrame *fr)
+static void print_special(FILE *f, const StatsField *r, const StatsSources *c)
 {
+    const StatsFrame *fr = c->fr;
     const RenderStats *st = fr->st;
     const int *n = fr->r->cs->grid.n;
+    const int *rect = r->at.type == T_REGION ? c->derived.region : c->derived.window;
     char feat[256];
     switch (r->at.type) {
     case T_FRAME:
@@ -479,6 +513,11 @@ static void print_special(FILE *f, const StatsField *r, const StatsFrame *fr)
             fprintf(f, "%s %d (%dx%d): %llu", l > 1 ? "," : "", l, 1 << l, 1 << l,
                     st->aa_refined[l]);
         break;
+    case T_REGION:
+    case T_WINDOW:
+        fprintf(f, r->text, (long long)rect[0], (long long)rect[1], (long long)rect[2],
+                (long long)rect[3]);
+        break;
     }
 }
 
@@ -488,7 +527,7 @@ static void print_field(FILE *f, const StatsField *r, const StatsSources *c)
     const StatsAt *at = r->text_at.type != T_NONE ? &r->text_at : &r->at;
     StatsValue v = stats_read(c, at);
     if (at->type >= T_FRAME)
-        print_special(f, r, c->fr);
+        print_special(f, r, c);
     else if (at->type == T_NONE)
         fputs(r->text, f);
     else if (at->type == T_DOUBLE || at->type == T_FLOAT)
@@ -624,6 +663,14 @@ static void json_special(cJSON *o, const StatsField *r, const StatsSources *c, i
         a = arr(o, r->key, ok);
         for (int l = 1; a && (c->derived.when & W_ADAPTIVE) && l <= fr->scene->aa_max_level; l++)
             push(a, cJSON_CreateNumber((double)st->aa_refined[l]), ok);
+        break;
+    case T_REGION:
+    case T_WINDOW:
+        a = cJSON_CreateIntArray(r->at.type == T_REGION ? c->derived.region : c->derived.window, 4);
+        if (!a || !cJSON_AddItemToObject(o, r->key, a)) {
+            cJSON_Delete(a);
+            *ok = 0;
+        }
         break;
     case T_COUNTERS:
         json_counters(o, r, st, ok);

@@ -6,9 +6,10 @@
  *   scene_intersect_closest rays               -> hits, media (first interface of each ray)
  *   light_sample_shading    rays, hits, media  -> radiance (k_local term, shadow feelers)
  *   tree_trace_secondary    rays, hits, media  -> radiance += (k_global term: the ray tree;
- *                                                 only with VBCL_HAS_TRANSPARENCY), splits
- *   tree_trace_bands        splits             -> radiance += the recorded dispersive
- *                                                 subtrees (only with VBCL_HAS_DISPERSION)
+ *                                                 only with VBCL_HAS_TRANSPARENCY), splits;
+ *                           splits             -> radiance += the recorded dispersive
+ *                                                 subtrees (its second launch, `bands` 1:
+ *                                                 only with VBCL_HAS_DISPERSION)
  * The anti-aliasing kernels that trace nothing are film.cl's program. The frame's entry
  * points take the same arguments (FRAME_KERNEL_ARGS; aa_generate_rays adds the pass,
  * aa_split_rays the pass and the list, with dispersion the tree kernels add the split
@@ -20,6 +21,7 @@
 #define VBCL_RENDER_CL
 
 #include "aa.cl"
+#include "environment.cl"
 #include "light.cl"
 #include "medium.cl"
 #include "scene.cl"
@@ -115,15 +117,29 @@ VB_INLINE uint sample_key(__constant const VbFrame *f, uint sample)
     return vb_hash(sample ^ vb_hash(f->seed));
 }
 
+/* The place in the image of pixel p of the frame's window (VbFrame.window_x ...: row by
+ * row, window_width a row). */
+VB_INLINE int2 frame_pixel_xy(__constant const VbFrame *f, uint p)
+{
+    return (int2)(f->window_x + (int)(p % (uint)f->window_width),
+                  f->window_y + (int)(p / (uint)f->window_width));
+}
+
+/* The index in the whole image (row-major) of the pixel at xy: the id of its pass-0 sample
+ * and the key of its supersamples' ids, whatever window renders it. */
+VB_INLINE uint frame_pixel_index(__constant const VbFrame *f, int2 xy)
+{
+    return (uint)(xy.y * f->width + xy.x);
+}
+
 /* frame -> rays: one ray through the centre of each pixel of the tile; the sample id is
- * the pixel index. */
+ * the pixel's index in the image. */
 __kernel void camera_generate_rays(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);
     if (i >= f->tile_pixels) return;
-    int pixel = f->first_pixel + i;
-    int x = pixel % f->width, y = pixel / f->width;
-    rays[i] = camera_ray(f, (float)x + 0.5f, (float)y + 0.5f, (uint)pixel);
+    int2 xy = frame_pixel_xy(f, (uint)(f->first_pixel + i));
+    rays[i] = camera_ray(f, (float)xy.x + 0.5f, (float)xy.y + 0.5f, frame_pixel_index(f, xy));
 }
 
 /* This work group's copy of the counters (VBCL_COUNTER_SLOTS in types.h). */
@@ -182,7 +198,7 @@ VB_INLINE void shade_flush_counts(__global uint *counters, const TraceCount *tc,
 }
 
 /* rays, hits, media -> radiance (rgb + 1 per ray): the k_local term at each primary hit
- * with shadow feelers, or the background for rays that left the scene. */
+ * with shadow feelers, or the environment or background for rays that left the scene. */
 __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 {
     int i = get_global_id(0);
@@ -198,7 +214,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
     if (tracked) before = media[i];
 #endif
     if (h.tri < 0) {
-        col = vb_cload3(f->background);
+        col = scene_escape_radiance(&sc, dir);
 #ifdef VBCL_HAS_MEDIA
         if (tracked) col *= medium_absorb(&sc, medium_material(&sc, before), INFINITY);
 #endif
@@ -224,7 +240,7 @@ __kernel void light_sample_shading(FRAME_KERNEL_ARGS)
 
 #ifdef VBCL_HAS_TRANSPARENCY
 #ifdef VBCL_HAS_DISPERSION
-#define TREE_SPLIT_ARG , __global VbSplitSet *splits
+#define TREE_SPLIT_ARG , __global VbSplitSet *splits, int bands
 #else
 #define TREE_SPLIT_ARG
 #endif
@@ -246,7 +262,7 @@ VB_INLINE float3 tree_run(const DevScene *sc, TreeRay *stack, int n, float share
         VbMedium state = tr.medium;
         PathHit ph;
         if (!tree_trace(sc, &tr, &state, &ph, tc, &cnt->passes)) {
-            acc += tr.weight * vb_cload3(f->background) *
+            acc += tr.weight * scene_escape_radiance(sc, tr.dir) *
                    medium_absorb(sc, medium_material(sc, state), INFINITY);
             continue;
         }
@@ -288,108 +304,103 @@ VB_INLINE void tree_flush_counts(__global uint *counters, const TreeCount *cnt,
 
 /* rays, hits, media -> radiance += the k_global term: the reflected and transmitted
  * subtree below each primary hit on a dielectric, with its own shadow feelers. With
- * dispersion, the first VBCL_SPLIT_SLOTS splits of each tree are left in splits for
- * tree_trace_bands, with the pruning budget that is left. */
+ * dispersion the kernel runs twice a batch: with `bands` 0 it traces the white trees and
+ * leaves the first VBCL_SPLIT_SLOTS splits of each tree in splits, with the pruning budget
+ * that is left; with `bands` 1 it traces those dispersive subtrees, each split's bands
+ * (tree_push_bands) and everything below them. One kernel with one copy of the inlined
+ * tree_run for both, so that a driver compiles the walk once (a second kernel of its own
+ * doubled the dispersive program's compile); two launches, so that the time spent in
+ * dispersive subtrees is measured (--stats). */
 __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
 #ifdef VBCL_HAS_DISPERSION
-    __global VbSplitSet *rec = (f->flags & VBCL_FRAME_DISPERSION) ? splits + i : 0;
+    __global VbSplitSet *rec = bands ? 0 : (f->flags & VBCL_FRAME_DISPERSION) ? splits + i : 0;
     if (rec) {
         rec->count = 0;
         rec->budget = 0.0f;
     }
+    int trees = bands ? splits[i].count : 1;
+    if (trees == 0) return;
 #else
     __global VbSplitSet *rec = 0;
+    const int bands = 0, trees = 1;
 #endif
-    VbHit h = hits[i];
-    if (h.tri < 0) return;
     DevScene sc = DEV_SCENE;
-    VbRay r = rays[i];
-    float3 dir = vb_load3(r.dir);
-    VbMedium before = media[i];
-    Crossing c = medium_cross(&sc, h.tri, dir, before);
-    if (materials[c.surface].k_global <= 0.0f) return;
-    uint key = sample_key(f, r.sample);
-    ShadePoint sp = shade_point_make(&sc, dir, h, key, before, c.surface);
     TreeRay stack[VB_TREE_STACK];
-    int n = 0;
     TreeCount cnt = {0};
     cnt.prune_budget = f->min_weight;
     TraceCount tc = {0, 0};
     ShadowCount shc = {0, 0, 0, 0, 0, 0};
-    tree_spawn(&sc, stack, &n, &sp, dir, &c, before, medium_absorb(&sc, c.mat_before, h.t), 1, &cnt,
-               -1, rec);
-    float3 acc = tree_run(&sc, stack, n, sample_share(f, r.sample), &cnt, &tc, &shc, rec);
+    VbRay r = rays[i];
+    ShadePoint sp;
+    Crossing c;
+    float3 dir, weight;
+    VbMedium before;
+    if (!bands) {
+        VbHit h = hits[i];
+        if (h.tri < 0) return;
+        dir = vb_load3(r.dir);
+        before = media[i];
+        c = medium_cross(&sc, h.tri, dir, before);
+        if (materials[c.surface].k_global <= 0.0f) return;
+        sp = shade_point_make(&sc, dir, h, sample_key(f, r.sample), before, c.surface);
+        weight = medium_absorb(&sc, c.mat_before, h.t);
+    }
+#ifdef VBCL_HAS_DISPERSION
+    else
+        cnt.prune_budget = splits[i].budget;
+#endif
+    float3 acc = (float3)(0.0f);
+    float share = sample_share(f, r.sample);
+    for (int k = 0; k < trees; k++) {
+        int n = 0;
+#ifdef VBCL_HAS_DISPERSION
+        if (bands) {
+            VbSplit s = splits[i].s[k];
+            sp.p = vload3(0, s.p);
+            sp.err = s.p[3];
+            sp.ng = vload3(0, s.ng);
+            sp.ns = vload3(0, s.ns);
+            sp.tri = -1; /* not recorded: its rays leave nothing out (ray_objects) */
+            c.after = s.after;
+            c.mat_before = s.mat_before;
+            c.mat_after = s.mat_after;
+            tree_push_bands(&sc, stack, &n, &sp, vload3(0, s.dir), &c, vload3(0, s.weight), s.depth,
+                            s.key, &cnt);
+        } else
+#endif
+            tree_spawn(&sc, stack, &n, &sp, dir, &c, before, weight, 1, &cnt, -1, rec);
+        acc += tree_run(&sc, stack, n, share, &cnt, &tc, &shc, rec);
+    }
     vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
 #ifdef VBCL_HAS_DISPERSION
     if (rec) rec->budget = cnt.prune_budget;
 #endif
     tree_flush_counts(COUNTER_SLOT(counters), &cnt, &tc, &shc);
 }
-
-#ifdef VBCL_HAS_DISPERSION
-/* splits -> radiance += the dispersive subtrees tree_trace_secondary recorded: for each
- * recorded split its bands (tree_push_bands) and everything below them. Its own kernel, so
- * that the time spent in dispersive subtrees is measured (--stats). */
-__kernel void tree_trace_bands(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
-{
-    int i = get_global_id(0);
-    if (i >= nrays) return;
-    __global const VbSplitSet *rec = splits + i;
-    int count = rec->count;
-    if (count == 0) return;
-    DevScene sc = DEV_SCENE;
-    TreeRay stack[VB_TREE_STACK];
-    TreeCount cnt = {0};
-    cnt.prune_budget = rec->budget;
-    TraceCount tc = {0, 0};
-    ShadowCount shc = {0, 0, 0, 0, 0, 0};
-    float3 acc = (float3)(0.0f);
-    float share = sample_share(f, rays[i].sample);
-    for (int k = 0; k < count; k++) {
-        VbSplit s = rec->s[k];
-        ShadePoint sp;
-        sp.p = vload3(0, s.p);
-        sp.err = s.p[3];
-        sp.ng = vload3(0, s.ng);
-        sp.ns = vload3(0, s.ns);
-        sp.tri = -1; /* not recorded: its rays leave nothing out (ray_objects) */
-        Crossing c;
-        c.after = s.after;
-        c.mat_before = s.mat_before;
-        c.mat_after = s.mat_after;
-        int n = 0;
-        tree_push_bands(&sc, stack, &n, &sp, vload3(0, s.dir), &c, vload3(0, s.weight), s.depth,
-                        s.key, &cnt);
-        acc += tree_run(&sc, stack, n, share, &cnt, &tc, &shc, 0);
-    }
-    vstore4(vload4(i, radiance) + (float4)(acc, 0.0f), i, radiance);
-    tree_flush_counts(COUNTER_SLOT(counters), &cnt, &tc, &shc);
-}
-#endif
 #endif
 
 /* frame -> rays: uniform supersampling, side x side rays through the subpixel centres of
- * each pixel of a batch of pixels from aa->first on (complete stratification), ray i
- * belonging to pixel first + i / side^2 and subpixel i % side^2 (row-major). */
+ * each pixel of a batch of pixels of the window from aa->first on (complete
+ * stratification), ray i belonging to pixel first + i / side^2 and subpixel i % side^2
+ * (row-major). */
 __kernel void aa_generate_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa)
 {
     int i = get_global_id(0);
     if (i >= nrays) return;
-    uint n = (uint)(aa->side * aa->side);
-    uint pixel = aa->first + (uint)i / n, sub = (uint)i % n;
-    int x = (int)(pixel % (uint)f->width), y = (int)(pixel / (uint)f->width);
+    uint n = (uint)(aa->side * aa->side), sub = (uint)i % n;
+    int2 xy = frame_pixel_xy(f, aa->first + (uint)i / n);
     float inv = 1.0f / (float)aa->side;
-    float px = (float)x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
-    float py = (float)y + ((float)(sub / (uint)aa->side) + 0.5f) * inv;
-    rays[i] = camera_ray(f, px, py, aa_sample_id(pixel, aa->side, sub));
+    float px = (float)xy.x + ((float)(sub % (uint)aa->side) + 0.5f) * inv;
+    float py = (float)xy.y + ((float)(sub / (uint)aa->side) + 0.5f) * inv;
+    rays[i] = camera_ray(f, px, py, aa_sample_id(frame_pixel_index(f, xy), aa->side, sub));
 }
 
 /* frame, marks -> rays: three rays per marked node of a batch, through the samples of the
  * three children that do not hold the node's own sample (aa_tree.h): ray i belongs to
- * mark first + i / 3. */
+ * mark first + i / 3 (its pixel one of the window's). */
 __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
                             __global const uint2 *marks)
 {
@@ -399,9 +410,10 @@ __kernel void aa_split_rays(FRAME_KERNEL_ARGS, __constant const VbAaPass *aa,
     uint child = aa_new_child(m.y, i % 3);
     int cell = aa_new_child_cell(child);
     float2 at = aa_cell_position(cell);
-    int x = (int)(m.x % (uint)f->width), y = (int)(m.x / (uint)f->width);
-    rays[i] = camera_ray(f, (float)x + at.x, (float)y + at.y,
-                         aa_tree_sample_id(m.x, (uint)cell, aa_node_level(child)));
+    int2 xy = frame_pixel_xy(f, m.x);
+    rays[i] =
+        camera_ray(f, (float)xy.x + at.x, (float)xy.y + at.y,
+                   aa_tree_sample_id(frame_pixel_index(f, xy), (uint)cell, aa_node_level(child)));
 }
 
 #endif

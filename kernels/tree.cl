@@ -102,7 +102,7 @@ VB_INLINE void tree_push_bands(const DevScene *sc, TreeRay *stack, int *n, const
     }
 }
 
-/* Records a split in the ray's next free slot for tree_trace_bands; 0 when the slots are
+/* Records a split in the ray's next free slot for the band launch; 0 when the slots are
  * full (the caller then pushes the bands itself). */
 VB_INLINE int tree_record_split(__global VbSplitSet *rec, const ShadePoint *sp, float3 dir,
                                 const Crossing *c, float3 wg, int depth, uint tkey)
@@ -126,9 +126,9 @@ VB_INLINE int tree_record_split(__global VbSplitSet *rec, const ShadePoint *sp, 
 /* Pushes the children of a ray of band `band` (-1: white) that arrived along dir with
  * weight w at the interface c (seen at shading point sp, medium `before` on the incoming
  * side). A white ray refracting at an interface with a dispersive side splits: its
- * transmitted part becomes one ray per band (tree_push_bands), recorded in rec for
- * tree_trace_bands while it has a free slot; the reflected ray stays one white ray,
- * weighted by the band-weighted sum of the R. rec may be 0 (bands pushed here). */
+ * transmitted part becomes one ray per band (tree_push_bands), recorded in rec for the
+ * band launch of tree_trace_secondary while it has a free slot; the reflected ray stays one white
+ * ray, weighted by the band-weighted sum of the R. rec may be 0 (bands pushed here). */
 VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const ShadePoint *sp,
                           float3 dir, const Crossing *c, VbMedium before, float3 w, int depth,
                           TreeCount *cnt, int band, __global VbSplitSet *rec)

@@ -18,7 +18,8 @@
 #define VBCL_FEATURE_FRESNEL_THESIS (1u << 6) /* split by thesis eq. 9, not Fresnel */
 #define VBCL_FEATURE_PATTERNS       (1u << 7) /* some material has a surface pattern */
 #define VBCL_FEATURE_DISPERSION     (1u << 8) /* some dielectric's eta depends on wavelength */
-#define VBCL_FEATURE_COUNT          9
+#define VBCL_FEATURE_ENVIRONMENT    (1u << 9) /* rays that leave the scene see image.environment */
+#define VBCL_FEATURE_COUNT          10
 
 /* VbPattern.kind: the solid textures that colour surfaces (thesis 2.2.2.3). */
 #define VBCL_PATTERN_FOURIER    1 /* Gardner's Fourier synthesis G(X, Y, Z) */
@@ -107,8 +108,8 @@ typedef struct VbRay {
     float org[3];
     float tmax;          /* farthest accepted hit distance (in units of |dir|) */
     float dir[3];        /* unit length */
-    unsigned int sample; /* the film sample's id, the key of its shading jitter: the pixel
-                          * index for a ray through a pixel's centre, a hash of (pixel,
+    unsigned int sample; /* the film sample's id, the key of its shading jitter: the pixel's
+                          * index in the image for a ray through its centre, a hash of (pixel,
                           * samples per axis, subpixel) for a supersample (aa_sample_id) */
 } VbRay;
 
@@ -306,7 +307,7 @@ typedef struct VbAaPass {
     float threshold;       /* a pair of neighbours fails when |a-b| / max(a+b, floor) > threshold */
     float contrast_scale;  /* values are scaled by 2^exposure and clamped to [0, 1] first */
     int max_level;         /* nodes at this level are never split */
-    int width, height;     /* image size in pixels */
+    int width, height;     /* the film's size in pixels: the frame's window (VbFrame) */
     int side;              /* uniform batch: samples per pixel axis (N of --ssaa) */
     float floor;           /* contrast: a + b below this counts as this (dark noise) */
     unsigned int first;    /* batch: its first entry in the list of marked nodes (or pixels) */
@@ -319,6 +320,19 @@ typedef struct VbAaPass {
                 * raster order (0, the thesis's) or both (1) (SCENE_AA_PAIRS_*) */
 } VbAaPass;
 
+/* The environment (image.environment, kernels/environment.cl): a latitude-longitude image in
+ * the texels, seen by every ray that leaves the scene (VBCL_FRAME_ENVIRONMENT). A direction
+ * d is looked up at e = rot d (rot's rows: the world-to-environment rotation), u =
+ * atan2(e.x, -e.z) / 2pi in [0, 1) and v = acos(e.y) / pi, bilinearly between texel centres
+ * along u (x = u width - 1/2, wrapping) and between rows along v (y = v (height - 1): row 0
+ * the zenith, the last the nadir), as Mitsuba 3's envmap. */
+typedef struct VbEnvironment {
+    float rot[3][4];    /* rows of the world-to-environment rotation ([k][3] unused, 0) */
+    unsigned int first; /* its first texel (4 floats each) in the texels, row 0 first */
+    int width, height;  /* texels */
+    unsigned int pad;
+} VbEnvironment;
+
 /* Everything a frame's kernels read besides the big buffers. */
 typedef struct VbFrame {
     VbCamera camera;
@@ -326,7 +340,7 @@ typedef struct VbFrame {
     float background[4]; /* rgb radiance of rays that leave the scene */
     float ambient[4];    /* rgb ambient light */
     int width, height;   /* full image size in pixels */
-    int first_pixel;     /* index of the tile's first pixel in the image (row-major) */
+    int first_pixel;     /* index of the tile's first pixel in the window (row-major) */
     int tile_pixels;     /* pixels in this tile */
     unsigned int nlights;
     unsigned int ntris;
@@ -345,6 +359,15 @@ typedef struct VbFrame {
                                    * this many times as many (1: never; light_reflect_area) */
     unsigned int pad[2];
     VbCamTiles cam_tiles;
+    /* The window: the part of the image the frame renders (host/frame/frame.h, frame_window:
+     * a --crop region and the anti-aliasing's margin around it; the whole image without
+     * --crop). Tiles, the film and the anti-aliasing's pixel indices count its pixels, row
+     * by row (window_width a row); camera rays and sample ids use the pixel's place in the
+     * whole image, so a pixel renders the same in any window. */
+    int window_x, window_y; /* its top-left pixel in the image */
+    int window_width, window_height;
+    VbEnvironment env; /* with VBCL_FRAME_ENVIRONMENT: what rays leaving the scene see
+                        * instead of background */
 } VbFrame;
 
 /* VbFrame.flags */
@@ -366,13 +389,14 @@ typedef struct VbFrame {
 #define VBCL_FRAME_TEXTURES        256u  /* some object holds a volume texture */
 #define VBCL_FRAME_DISPERSION      512u  /* some transparent material disperses: split records */
 #define VBCL_FRAME_ABSORPTION      1024u /* some transparent material has an extinction > 0 */
+#define VBCL_FRAME_ENVIRONMENT     2048u /* rays that leave the scene see env, not background */
 #define VBCL_CONE_TEST_MAX_OBJECTS 64    /* scenes with more objects trace every feeler */
 #define VBCL_CONE_TEST_MAX_ELEMENTS                                                                \
     64 /* a texture of more parts (connected pieces) than this is bounded as a whole */
 
 /* Dispersion: a white ray's refraction into bands, recorded by tree_trace_secondary and
- * traced by tree_trace_bands (so that the time spent in dispersive subtrees is the second
- * kernel's time). Each ray has VBCL_SPLIT_SLOTS records; further splits of the same tree are
+ * traced by its second launch (so that the time spent in dispersive subtrees is that
+ * launch's time). Each ray has VBCL_SPLIT_SLOTS records; further splits of the same tree are
  * traced inline. Device data only: the host sizes the buffer. */
 #define VBCL_SPLIT_SLOTS 2
 typedef struct VbSplit {
@@ -414,7 +438,7 @@ typedef struct VbSplitSet {
     X(VBCL_OFFSETOF(VbFrame, width)) X(VBCL_OFFSETOF(VbFrame, seed))                               \
     X(VBCL_OFFSETOF(VbFrame, camera_medium)) X(VBCL_OFFSETOF(VbFrame, min_weight))                 \
     X(VBCL_OFFSETOF(VbFrame, max_depth)) X(VBCL_OFFSETOF(VbFrame, bands))                          \
-    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
+    X(VBCL_OFFSETOF(VbFrame, band_weights)) X(VBCL_OFFSETOF(VbFrame, flags)) X(VBCL_OFFSETOF(VbFrame, nobjects)) X(VBCL_OFFSETOF(VbFrame, penumbra_factor)) X(VBCL_OFFSETOF(VbFrame, cam_tiles)) X(VBCL_OFFSETOF(VbFrame, window_x)) X(VBCL_OFFSETOF(VbFrame, env)) X(sizeof(VbEnvironment)) X(VBCL_OFFSETOF(VbEnvironment, first)) X(sizeof(VbCamTiles)) X(VBCL_OFFSETOF(VbCamTiles, nx)) X(sizeof(VbAaPass)) X(VBCL_OFFSETOF(VbAaPass, side))   \
     X(VBCL_OFFSETOF(VbAaPass, first)) X(VBCL_OFFSETOF(VbAaPass, floor)) X(VBCL_OFFSETOF(VbAaPass, level_gain)) X(VBCL_OFFSETOF(VbAaPass, reconstruct)) X(VBCL_OFFSETOF(VbAaPass, tree_cap)) X(VBCL_OFFSETOF(VbAaPass, pairs)) X(sizeof(VbSplit))    \
     X(VBCL_OFFSETOF(VbSplit, after)) X(VBCL_OFFSETOF(VbSplit, key)) X(sizeof(VbSplitSet))          \
     X(VBCL_OFFSETOF(VbSplitSet, count))
@@ -462,8 +486,12 @@ VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane_eps) == 44, object_plane_eps);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, hi) == 48, object_hi);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbObject, plane) == 64, object_plane);
 VBCL_STATIC_ASSERT(sizeof(VbMedium) == 8, medium_size);
-VBCL_STATIC_ASSERT(sizeof(VbFrame) == 304, frame_size);
+VBCL_STATIC_ASSERT(sizeof(VbFrame) == 384, frame_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, window_x) == 304, frame_window_x);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, cam_tiles) == 256, frame_cam_tiles);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, env) == 320, frame_env);
+VBCL_STATIC_ASSERT(sizeof(VbEnvironment) == 64, environment_size);
+VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbEnvironment, first) == 48, environment_first);
 VBCL_STATIC_ASSERT(sizeof(VbCamTiles) == 48, cam_tiles_size);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbCamTiles, nx) == 32, cam_tiles_nx);
 VBCL_STATIC_ASSERT(VBCL_OFFSETOF(VbFrame, flags) == 236, frame_flags);
@@ -525,6 +553,6 @@ VBCL_STATIC_ASSERT(VBCL_COUNTERS <= VBCL_COUNTER_STRIDE && VBCL_COUNTER_STRIDE %
     X(__global, VbObject, objects, objects)                                                        \
     X(__global, VbLight, lights, lights)                                                           \
     X(__global, VbPattern, patterns, patterns)                                                     \
-    X(__global, float, texels, texels) /* projected images, 4 floats per texel */
+    X(__global, float, texels, texels) /* images, band tables, environment: 4 floats each */
 
 #endif

@@ -211,7 +211,7 @@ def part_thesis(a, out):
     note = (f"`{A4}` at {size}x{size} (the thesis: 400x400), grid 20 as in the thesis, "
             f"{'median of ' + str(reps) if reps > 1 else 'one run per row'}. render_s: the render's wall time less the anti-aliasing "
             "stages' device time; aa_s: contrast, refinement and reconstruction (device); "
-            "dispersion_s: tree_trace_bands, the dispersive subtrees (device, inside render_s "
+            "dispersion_s: the band launch of tree_trace_secondary, the dispersive subtrees (device, inside render_s "
             "and aa_s); total_s: the whole run (scene, grid, warm program, render, write). "
             "thesis_*: section 4.1.5, seconds on an SGI IRIS Indigo (1995); speedup: "
             "thesis_total_s / total_s.")

@@ -27,7 +27,8 @@ typedef struct AaRender {
 } AaRender;
 
 /* Reads a heat map (EXR) of w x h into values: each pixel the n in lo..hi whose colour
- * (colour(n)) is nearest, which must be within 1e-6. Returns 0 or -1. */
+ * (colour(n)) is nearest, which must be within 1e-6. The map is the image's top-left
+ * w x h pixels, its legend to the right (aa_map.h): the image is wider. Returns 0 or -1. */
 static int aa_read_map(const char *path, int w, int h, int lo, int hi,
                        void (*colour)(int, float[3]), int *values)
 {
@@ -38,14 +39,16 @@ static int aa_read_map(const char *path, int w, int h, int lo, int hi,
         CHECK(0, "%s", err);
         return -1;
     }
-    CHECK(mw == w && mh == h, "map %dx%d, image %dx%d", mw, mh, w, h);
-    for (int i = 0; i < mw * mh && mw == w && mh == h; i++) {
+    int fits = mw > w && mh >= h;
+    CHECK(fits, "map %dx%d has no legend beside the %dx%d image", mw, mh, w, h);
+    for (int i = 0; i < w * h && fits; i++) {
+        const float *p = m + 4 * ((size_t)(i / w) * (size_t)mw + (size_t)(i % w));
         double best = 1e30;
         for (int n = lo; n <= hi; n++) {
             float c[3];
             colour(n, c);
             double d = 0;
-            for (int k = 0; k < 3; k++) d += (m[4 * i + k] - c[k]) * (m[4 * i + k] - c[k]);
+            for (int k = 0; k < 3; k++) d += (p[k] - c[k]) * (p[k] - c[k]);
             if (d < best) {
                 best = d;
                 values[i] = n;
@@ -54,7 +57,7 @@ static int aa_read_map(const char *path, int w, int h, int lo, int hi,
         CHECK(best < 1e-12, "%s: pixel %d is no palette colour", path, i);
     }
     free(m);
-    return 0;
+    return fits ? 0 : -1;
 }
 
 /* Renders the test scene with extra options (to EXR; with map set, also --aa-map and

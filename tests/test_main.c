@@ -61,6 +61,26 @@ char *tu_read_file(const char *path, char *buf, size_t n)
     return buf;
 }
 
+void tu_expect_refused(const char *scene_path, const char *args, const char *needle)
+{
+    char img[512], cmd[4096], out[8192], buf[64];
+    snprintf(img, sizeof img, "%s/keep.png", tu_tmpdir());
+    FILE *f = fopen(img, "w");
+    if (f) {
+        fputs("previous image", f);
+        fclose(f);
+    }
+    /* a hang fails (124) */
+    snprintf(cmd, sizeof cmd, "timeout 300 %s %s -o %s %s", tu_vbcl, scene_path, img, args);
+    int rc = tu_run(cmd, out, sizeof out);
+    CHECK(rc == 2, "%s: exit 2 for bad input (got %d): %s", args, rc, out);
+    CHECK(strstr(out, needle) != NULL, "%s: the message \"%s\" names \"%s\"", args, out, needle);
+    char *nl = strchr(out, '\n');
+    CHECK(nl && nl[1] == 0, "%s: exactly one line: %s", args, out);
+    CHECK(strcmp(tu_read_file(img, buf, sizeof buf), "previous image") == 0,
+          "%s: existing output untouched", args);
+}
+
 int tu_dir_has(const char *dir, const char *part)
 {
     DIR *d = opendir(dir);
@@ -135,13 +155,16 @@ int main(int argc, char **argv)
     suite_cli();
     suite_optics();
     suite_patterns();
+    suite_environment();
     suite_stability();
     suite_render();
     suite_aa();
+    suite_aa_map();
     suite_dispersion();
     suite_structure();
     suite_scale();
     suite_faults();
     suite_frame();
+    suite_crop();
     return th_summary();
 }

@@ -318,8 +318,11 @@ static void test_scale_mpi_failure(void)
     if (!mpi) return;
     char cmd[4096], out[8192], img[1024];
     snprintf(img, sizeof img, "%s/mpi_fail.png", tu_tmpdir());
-    /* 400x400: 16 tiles of about half a second each, so that rank 1 takes one */
-    const char *scene = "scenes/quickstart.json";
+    /* 1200x1200: about 6 s of tiles on the 2-core Xeon, so that rank 1 takes one even when
+     * it starts seconds after rank 0 (at 400x400 rank 0 rendered the whole image in 0.7 s,
+     * before a rank 1 slowed by a loaded machine had opened its device); the run ends at
+     * rank 1's first tile */
+    const char *scene = "scenes/quickstart.json --width 1200 --height 1200";
     remove(img);
     snprintf(cmd, sizeof cmd, "%s -np 1 %s %s -q -o %s : -np 1 env VBCL_FAIL_TILE=1 %s %s -q -o %s",
              mpi, tu_vbcl, scene, img, tu_vbcl, scene, img);

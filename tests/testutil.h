@@ -27,6 +27,11 @@ const char *tu_write_file(const char *name, const char *text);
  * cannot be opened); returns buf. */
 char *tu_read_file(const char *path, char *buf, size_t n);
 
+/* Runs vbcl on the scene file at scene_path with args, writing to an output file that
+ * already holds an older image, and checks what every refusal of bad input does: exit 2,
+ * one line that contains needle, the older file untouched. */
+void tu_expect_refused(const char *scene_path, const char *args, const char *needle);
+
 /* Whether directory dir holds a file whose name contains part. */
 int tu_dir_has(const char *dir, const char *part);
 
@@ -43,11 +48,14 @@ void suite_patterns(void);
 void suite_stability(void);
 void suite_render(void);
 void suite_aa(void);
+void suite_aa_map(void);
 void suite_dispersion(void);
 void suite_structure(void);
 void suite_scale(void);
 void suite_faults(void);
 void suite_frame(void);
+void suite_crop(void);
+void suite_environment(void);
 
 /* A test that runs probe kernels (tests/fixture.c): with workers (vbcl-tests -j), all such
  * tests run in one worker, which compiles each probe kernel once at its first launch while

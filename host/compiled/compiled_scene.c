@@ -1,7 +1,7 @@
 /* compiled_scene.c — the scene into the kernels' layout, on the host: triangles with their
  * tags, smooth normals, the grid's leaves and the objects' ranges four triangles at a time,
  * materials, surface patterns (Fourier coefficients and projected images), dispersion band
- * tables, camera tiles and frame constants. */
+ * tables, the environment's texels, camera tiles and frame constants. */
 #include "compiled_scene.h"
 
 #include <math.h>
@@ -179,7 +179,7 @@ static VbTriNormals *pack_normals(const Scene *s)
     return t;
 }
 
-/* The texels buffer under construction: projected images, then the band tables. */
+/* The texels buffer under construction: projected images, the band tables, the environment. */
 typedef struct Texels {
     float *v;
     size_t n; /* in texels of 4 floats */
@@ -276,6 +276,28 @@ static int band_tables_make(const Scene *s, VbMaterial *mats, Texels *tx, unsign
     return 0;
 }
 
+/* The environment's texels (the image times its scale) appended to tx, and where they are
+ * and how they turn into e. Returns 0, or 1 (out of memory). */
+static int environment_make(const Scene *s, Texels *tx, VbEnvironment *e, char *err, size_t errlen)
+{
+    const SceneEnvironment *se = &s->env;
+    size_t n = (size_t)se->width * (size_t)se->height, first = tx->n;
+    float *t = texels_grow(tx, n);
+    if (!t) {
+        snprintf(err, errlen, "out of memory for the environment %s", se->file);
+        return 1;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 4; k++) t[4 * i + k] = se->texels[4 * i + k] * se->scale;
+    memset(e, 0, sizeof *e);
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) e->rot[r][k] = se->to_env[r][k];
+    e->first = (unsigned)first;
+    e->width = se->width;
+    e->height = se->height;
+    return 0;
+}
+
 /* The frame constants of s: camera, grid, background, lights, feelers, media, limits. */
 static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbFrame *f)
 {
@@ -286,6 +308,8 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     memcpy(f->ambient, s->ambient, sizeof s->ambient);
     f->width = s->width;
     f->height = s->height;
+    f->window_width = s->width; /* the whole image, unless the frame driver crops it */
+    f->window_height = s->height;
     f->nlights = (unsigned)s->nlights;
     f->ntris = s->mesh.ntris;
     unsigned strata = (unsigned)lround(sqrt((double)s->shadow_samples));
@@ -312,12 +336,12 @@ static void frame_fill(const Scene *s, const Grid *g, unsigned band_weights, VbF
     f->band_weights = band_weights;
 }
 
-/* The materials' surface patterns and, with dispersion, the band tables into cs
- * (materials' pattern and disp set; band_weights: the bands' first texel float). Returns 0,
- * 2 (a pattern the scene cannot have, the message naming the material) or 1 (out of
- * memory). */
-static int patterns_make(CompiledScene *cs, const Scene *s, unsigned *band_weights, char *err,
-                         size_t errlen)
+/* The materials' surface patterns, with dispersion the band tables, and the environment
+ * into cs (materials' pattern and disp set; band_weights: the bands' first texel float; env:
+ * the environment's place in the texels). Returns 0, 2 (a pattern the scene cannot have, the
+ * message naming the material) or 1 (out of memory). */
+static int patterns_make(CompiledScene *cs, const Scene *s, unsigned *band_weights,
+                         VbEnvironment *env, char *err, size_t errlen)
 {
     VbMaterial *mats = cs->materials;
     cs->patterns = calloc((size_t)s->nmaterials + 1, sizeof *cs->patterns);
@@ -337,15 +361,16 @@ static int patterns_make(CompiledScene *cs, const Scene *s, unsigned *band_weigh
     } else {
         for (int i = 0; i < s->nmaterials; i++) mats[i].disp = -1;
     }
+    if (!rc && s->env.file) rc = environment_make(s, &tx, env, err, errlen);
     cs->texels = tx.v;
     cs->ntexels = tx.n;
     return rc;
 }
 
 /* The materials (the scene's, then the medium outside every host: vacuum, eta 1), with
- * their patterns and band tables. Returns as patterns_make. */
-static int materials_make(CompiledScene *cs, const Scene *s, unsigned *band_weights, char *err,
-                          size_t errlen)
+ * their patterns and band tables, and the environment. Returns as patterns_make. */
+static int materials_make(CompiledScene *cs, const Scene *s, unsigned *band_weights,
+                          VbEnvironment *env, char *err, size_t errlen)
 {
     cs->materials = calloc((size_t)s->nmaterials + 1, sizeof *cs->materials);
     if (!cs->materials) {
@@ -358,7 +383,7 @@ static int materials_make(CompiledScene *cs, const Scene *s, unsigned *band_weig
     air->eta = 1.0f;
     air->pattern = -1;
     air->disp = -1;
-    int rc = patterns_make(cs, s, band_weights, err, errlen);
+    int rc = patterns_make(cs, s, band_weights, env, err, errlen);
     air->k_global = 1.0f;
     return rc;
 }
@@ -601,10 +626,13 @@ int compiled_scene_update(CompiledScene *cs, const Scene *s, size_t max_alloc, c
     }
     shading_free(cs);
     unsigned band_weights = 0;
-    if (!rc) rc = materials_make(cs, s, &band_weights, err, errlen);
+    VbEnvironment env;
+    memset(&env, 0, sizeof env);
+    if (!rc) rc = materials_make(cs, s, &band_weights, &env, err, errlen);
     if (rc) return rc;
     VbCamTiles kept = cs->frame.cam_tiles;
     frame_fill(s, &cs->grid, band_weights, &cs->frame);
+    cs->frame.env = env;
     cs->frame.flags |= features_frame_flags(cs->features);
     return camera_tiles_update(cs, s, kept, max_alloc, err, errlen);
 }

@@ -28,7 +28,7 @@ typedef struct CompiledScene {
     int nmaterials;        /* the scene's + 1 */
     VbPattern *patterns;
     int npatterns;
-    float *texels; /* 4 floats each: projected images, then the band tables */
+    float *texels; /* 4 floats each: projected images, the band tables, the environment */
     size_t ntexels;
     CamTiles cam;  /* camera tiles (cam.nx 0: none) */
     VbFrame frame; /* the frame constants; the tile fields are 0 */

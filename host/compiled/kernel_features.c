@@ -26,11 +26,12 @@ static const struct {
     {VBCL_FEATURE_FRESNEL_THESIS, "fresnel-thesis", NULL},
     {VBCL_FEATURE_PATTERNS, "patterns", "VBCL_HAS_PATTERNS"},
     {VBCL_FEATURE_DISPERSION, "dispersion", "VBCL_HAS_DISPERSION"},
+    {VBCL_FEATURE_ENVIRONMENT, "environment", NULL},
 };
 
 #define OPAQUE_FEATURES                                                                            \
     (VBCL_FEATURE_AREA_LIGHTS | VBCL_FEATURE_SMOOTH_NORMALS | VBCL_FEATURE_SPECULAR |              \
-     VBCL_FEATURE_PATTERNS | VBCL_FEATURE_TEXTURES)
+     VBCL_FEATURE_PATTERNS | VBCL_FEATURE_TEXTURES | VBCL_FEATURE_ENVIRONMENT)
 #define DIELECTRIC_FEATURES                                                                        \
     (OPAQUE_FEATURES | VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_ABSORPTION |                       \
      VBCL_FEATURE_FRESNEL_THESIS)
@@ -102,6 +103,7 @@ unsigned features_of_scene(const Scene *s)
     }
     if ((f & VBCL_FEATURE_TRANSPARENCY) && s->fresnel == SCENE_FRESNEL_THESIS)
         f |= VBCL_FEATURE_FRESNEL_THESIS;
+    if (s->env.file) f |= VBCL_FEATURE_ENVIRONMENT;
     return f;
 }
 
@@ -137,7 +139,8 @@ unsigned features_frame_flags(unsigned f)
            ((f & VBCL_FEATURE_TRANSPARENCY) ? VBCL_FRAME_TRANSPARENCY : 0u) |
            ((f & VBCL_FEATURE_TEXTURES) ? VBCL_FRAME_TEXTURES : 0u) |
            ((f & VBCL_FEATURE_DISPERSION) ? VBCL_FRAME_DISPERSION : 0u) |
-           ((f & VBCL_FEATURE_ABSORPTION) ? VBCL_FRAME_ABSORPTION : 0u);
+           ((f & VBCL_FEATURE_ABSORPTION) ? VBCL_FRAME_ABSORPTION : 0u) |
+           ((f & VBCL_FEATURE_ENVIRONMENT) ? VBCL_FRAME_ENVIRONMENT : 0u);
 }
 
 /* "-cl-std=CL1.2", the tree stack when the program has transparency, and a -D for each of

@@ -91,7 +91,9 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
                 !clu_program_seen(r->dev, vbcl_film_source, film_options);
     if (fresh && build_notice_on) {
         char feat[160];
-        features_describe(r->program_features & ~VBCL_FEATURE_FRESNEL_THESIS, feat, sizeof feat);
+        features_describe(r->program_features &
+                              ~(VBCL_FEATURE_FRESNEL_THESIS | VBCL_FEATURE_ENVIRONMENT),
+                          feat, sizeof feat);
         fprintf(stderr,
                 "vbcl: compiling the %s kernels (%s) for %s, first time only (vbcl --warm-cache "
                 "compiles every program ahead)\n",
@@ -122,6 +124,16 @@ static int renderer_build(Renderer *r, const Scene *s, const char *probe_source,
         renderer_fit_local_size(r, *k);
     }
     return 0;
+}
+
+/* tree_trace_secondary's arguments after the frame's, in a program with dispersion: the
+ * split records, and which of its two launches it is (0: the white trees, 1: the
+ * dispersive subtrees they recorded). */
+#define RENDER_TREE_BANDS_ARG (RENDER_FRAME_ARGS + 1)
+
+static int renderer_tree_bands(cl_kernel k, cl_int bands)
+{
+    return clu_set_arg(k, RENDER_TREE_BANDS_ARG, sizeof bands, &bands);
 }
 
 /* The work items from which PoCL compiles a second work-group function of a kernel (its
@@ -158,7 +170,10 @@ static int renderer_first_launch(Renderer *r, RenderStats *st)
             first = RENDER_FRAME_ARGS;
         }
         for (cl_uint a = first; a < nargs; a++) /* the pass, marks, lists, trees, splits */
-            if (clu_set_arg(k, a, sizeof(cl_mem), &zero)) goto done;
+            if (k == r->k_tree && a == RENDER_TREE_BANDS_ARG
+                    ? renderer_tree_bands(k, 0)
+                    : clu_set_arg(k, a, sizeof(cl_mem), &zero))
+                goto done;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, renderer_local(r, global), 0,
                                         NULL, NULL),
                  done);
@@ -207,8 +222,10 @@ static int renderer_alloc_rays(Renderer *r, const Scene *s)
     /* a program with dispersion takes the split records whether the scene disperses or not;
      * only a dispersive scene writes them */
     if (r->program_features & VBCL_FEATURE_DISPERSION)
-        r->splits = clu_buffer(dev, NULL, r->k_bands ? sizeof(VbSplitSet) * (size_t)cap : 0,
-                               CL_MEM_READ_WRITE);
+        r->splits = clu_buffer(
+            dev, NULL,
+            (r->features & VBCL_FEATURE_DISPERSION) ? sizeof(VbSplitSet) * (size_t)cap : 0,
+            CL_MEM_READ_WRITE);
     return (r->program_features & VBCL_FEATURE_DISPERSION) && !r->splits;
 }
 
@@ -273,14 +290,17 @@ int renderer_trace_rays(Renderer *r, int n, RenderStats *st, double *trace_ms)
              done);
     /* first interfaces, local shading, with dielectrics the ray trees, and with dispersion
      * the dispersive subtrees the trees left in r->splits */
-    cl_kernel stages[4] = {r->k_intersect, r->k_shading, r->k_tree, r->k_bands};
+    cl_kernel stages[4] = {r->k_intersect, r->k_shading, r->k_tree,
+                           (r->features & VBCL_FEATURE_DISPERSION) ? r->k_tree : NULL};
     for (int k = 0; k < 4; k++) {
         if (!stages[k]) continue;
         if (renderer_set_frame_args(r, stages[k], r->rays, n, r->hits, r->media, r->radiance,
                                     r->counters))
             goto done;
+        /* the arguments are taken at each launch: the same kernel runs twice */
         if (k >= 2 && r->splits &&
-            clu_set_arg(stages[k], RENDER_FRAME_ARGS, sizeof(cl_mem), &r->splits))
+            (clu_set_arg(stages[k], RENDER_FRAME_ARGS, sizeof(cl_mem), &r->splits) ||
+             renderer_tree_bands(stages[k], k == 3)))
             goto done;
         CL_CHECK(clEnqueueNDRangeKernel(d->queue, stages[k], 1, NULL, &global,
                                         renderer_local(r, global), 0, NULL, &ev[k]),

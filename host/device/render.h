@@ -31,7 +31,8 @@ typedef struct RenderStats {
     int scene_compiles;  /* compilations of the scene (compiled_scene_update) for this frame */
     int geometry_builds; /* of them, those that made the geometry (the others kept it) */
     double camera_ms, intersect_ms, shading_ms, tree_ms, readback_ms; /* event profiling */
-    double dispersion_ms; /* tree_trace_bands: the dispersive subtrees (event profiling) */
+    double dispersion_ms; /* tree_trace_secondary's second launch: the dispersive subtrees
+                           * (event profiling) */
     double render_ms;     /* wall time of the tile loop */
     int tiles, tile_pixels;
     /* anti-aliasing (--aa: adaptive, --ssaa: uniform; host/frame/aa.c) */
@@ -51,7 +52,6 @@ typedef struct RenderStats {
     X(intersect, "scene_intersect_closest", 0, 1, 0u)                                              \
     X(shading, "light_sample_shading", 0, 1, 0u)                                                   \
     X(tree, "tree_trace_secondary", 0, 1, VBCL_FEATURE_TRANSPARENCY)                               \
-    X(bands, "tree_trace_bands", 0, 1, VBCL_FEATURE_TRANSPARENCY | VBCL_FEATURE_DISPERSION)        \
     X(aa_generate, "aa_generate_rays", 0, 1, 0u)                                                   \
     X(aa_split_rays, "aa_split_rays", 0, 1, 0u)                                                    \
     X(aa_contrast, "aa_contrast_mark", 1, 0, 0u)                                                   \

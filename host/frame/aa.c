@@ -19,18 +19,32 @@
 enum { AA_COUNTS = VBCL_AA_MAX_LEVEL + 2 }; /* marks, marks per level 0..3(4), tree slots */
 #define AA_ALL UINT_MAX                     /* aa_mark: test every pixel, not a list */
 
+/* The pixels of r's frame window (VbFrame.window_width ...): the film's, which anti-aliasing
+ * refines; the whole image unless the frame is cropped. */
+static size_t aa_pixels(const Renderer *r)
+{
+    return (size_t)r->frame_host.window_width * (size_t)r->frame_host.window_height;
+}
+
+int aa_reach(const Scene *s)
+{
+    if (s->ssaa > 1 || !(s->aa_threshold > 0.0f)) return 0;
+    return AA_MAX_ROUNDS - s->aa_min_level + 1;
+}
+
 /* Creates the buffers every anti-aliasing mode needs (pass, film, slots, info, counts)
  * once. Returns 0, 1 (device) or 2 (too large for one allocation) with a message in err. */
-static int aa_setup(AaState *aa, Renderer *r, const Scene *s, char *err, size_t errlen)
+static int aa_setup(AaState *aa, Renderer *r, char *err, size_t errlen)
 {
     if (aa->pass) return 0;
     VbDevice *d = r->dev;
-    size_t npix = (size_t)s->width * (size_t)s->height;
+    size_t npix = aa_pixels(r);
     if (sizeof(float) * 4 * npix > d->max_alloc) {
         snprintf(err, errlen,
                  "%dx%d: anti-aliasing keeps the image on the device (%.0f MiB), more than one "
                  "allocation on %s allows (%.0f MiB)",
-                 s->width, s->height, (double)(sizeof(float) * 4 * npix) / 1048576.0, d->name,
+                 r->frame_host.window_width, r->frame_host.window_height,
+                 (double)(sizeof(float) * 4 * npix) / 1048576.0, d->name,
                  (double)d->max_alloc / 1048576.0);
         return 2;
     }
@@ -63,7 +77,7 @@ static int aa_capacity(const VbDevice *d, size_t need, size_t elem, const char *
 
 int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen)
 {
-    size_t want, npix = (size_t)s->width * (size_t)s->height;
+    size_t want, npix = aa_pixels(r);
     if (s->ssaa > 1 || !(s->aa_threshold > 0.0f) || s->aa_min_level == 0) return 0;
     return aa_capacity(r->dev, npix, sizeof(float) * 4 * AA_TREE_NODES, "trees", &want, err,
                        errlen);
@@ -242,11 +256,11 @@ fail:
  * every pixel (aa_contrast_mark) when `listed` is AA_ALL, else the `listed` pixels in
  * aa->list (at least one; aa_contrast_list), after clearing this round's half of
  * aa->split. Returns 0 or -1. */
-static int aa_mark(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned listed,
+static int aa_mark(AaState *aa, Renderer *r, VbAaPass *pass, unsigned listed,
                    cl_uint counts[AA_COUNTS], RenderStats *st)
 {
     VbDevice *d = r->dev;
-    size_t npix = (size_t)s->width * (size_t)s->height;
+    size_t npix = aa_pixels(r);
     cl_uint zero[AA_COUNTS - 1] = {0};
     pass->entries = listed;
     if (aa_write_pass(aa, r, pass)) return -1;
@@ -413,11 +427,11 @@ static int aa_split_levels(AaState *aa, Renderer *r, VbAaPass *pass, int forced,
 /* Ends refinement: each refined pixel becomes the mean of its cells (aa_resolve), the
  * film and each pixel's deepest level and leaf count come back, and st gets the samples
  * per pixel (max) and the pixels that reached each level. Returns 0 or -1. */
-static int aa_finish(AaState *aa, Renderer *r, const Scene *s, VbAaPass *pass, unsigned slots,
-                     float *rgba, RenderStats *st)
+static int aa_finish(AaState *aa, Renderer *r, VbAaPass *pass, unsigned slots, float *rgba,
+                     RenderStats *st)
 {
     VbDevice *d = r->dev;
-    size_t npix = (size_t)s->width * (size_t)s->height;
+    size_t npix = aa_pixels(r);
     pass->entries = slots;
     const cl_mem args[7] = {aa->pass, aa->slot_pixels, aa->levels, aa->values,
                             aa->film, aa->info,        aa->slots};
@@ -447,11 +461,10 @@ fail:
 
 /* Uploads the frame and pass 0's image, clears the slots, info and tree counter, and makes
  * room for the first tree slots. Returns 0, 1 or 2 as aa_reserve. */
-static int aa_start(AaState *aa, Renderer *r, const Scene *s, const float *rgba, char *err,
-                    size_t errlen)
+static int aa_start(AaState *aa, Renderer *r, const float *rgba, char *err, size_t errlen)
 {
     VbDevice *d = r->dev;
-    size_t npix = (size_t)s->width * (size_t)s->height;
+    size_t npix = aa_pixels(r);
     cl_int none = -1, zero = 0;
     cl_uint counts[AA_COUNTS] = {0};
     aa->npix = npix;
@@ -499,7 +512,8 @@ fail:
     return 1;
 }
 
-static void pass_init(VbAaPass *pass, const Scene *s)
+/* The pass's settings from s, its film r's frame window. */
+static void pass_init(VbAaPass *pass, const Renderer *r, const Scene *s)
 {
     memset(pass, 0, sizeof *pass);
     pass->threshold = s->aa_threshold;
@@ -509,8 +523,8 @@ static void pass_init(VbAaPass *pass, const Scene *s)
     pass->pairs = s->aa_pairs;
     pass->contrast_scale = exp2f(s->exposure);
     pass->max_level = s->aa_max_level;
-    pass->width = s->width;
-    pass->height = s->height;
+    pass->width = r->frame_host.window_width;
+    pass->height = r->frame_host.window_height;
 }
 
 /* The deepest level the marked leaves of a round split into. */
@@ -525,15 +539,15 @@ static int aa_round_level(const cl_uint counts[AA_COUNTS])
 int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
               char *err, size_t errlen)
 {
-    int rc = aa_setup(aa, r, s, err, errlen);
-    if (!rc) rc = aa_start(aa, r, s, rgba, err, errlen);
+    int rc = aa_setup(aa, r, err, errlen);
+    if (!rc) rc = aa_start(aa, r, rgba, err, errlen);
     if (rc) return rc;
-    unsigned long long npix = (unsigned long long)s->width * (unsigned long long)s->height;
+    unsigned long long npix = aa_pixels(r);
     unsigned long long leaves = npix;
     unsigned slots = 0;
     AaProgress pg = {progress, 0, clu_now_ms(), 0.0};
     VbAaPass pass;
-    pass_init(&pass, s);
+    pass_init(&pass, r, s);
     st->samples = npix;
     /* below the minimum level every node splits, untested: every pixel takes a tree slot */
     int forced = s->aa_min_level;
@@ -551,7 +565,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         if (rc) goto out;
         rc = 1;
         pass.round = round;
-        if (aa_mark(aa, r, s, &pass, listed, counts, st)) goto fail;
+        if (aa_mark(aa, r, &pass, listed, counts, st)) goto fail;
         if (counts[0] == 0) break;
         st->aa_rounds++;
         /* pixels split for the first time take a tree slot each */
@@ -571,7 +585,7 @@ int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats
         if (listed == 0) break; /* (a split always lists its own pixel) */
     }
     rc = 1;
-    if (aa_finish(aa, r, s, &pass, slots, rgba, st)) goto fail;
+    if (aa_finish(aa, r, &pass, slots, rgba, st)) goto fail;
     rc = 0;
     goto out;
 fail:
@@ -587,13 +601,13 @@ out:
 int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st,
                    char *err, size_t errlen)
 {
-    int rc = aa_setup(aa, r, s, err, errlen);
+    int rc = aa_setup(aa, r, err, errlen);
     if (rc) return rc;
     VbDevice *d = r->dev;
-    size_t npix = (size_t)s->width * (size_t)s->height;
+    size_t npix = aa_pixels(r);
     unsigned per = (unsigned)r->ray_capacity / (unsigned)(n * n);
     VbAaPass pass;
-    pass_init(&pass, s);
+    pass_init(&pass, r, s);
     pass.side = n;
     CL_CHECK(clEnqueueWriteBuffer(d->queue, r->buf.frame, CL_TRUE, 0, sizeof r->frame_host,
                                   &r->frame_host, 0, NULL, NULL),

@@ -37,8 +37,8 @@ typedef struct AaState {
     int npasses;
 } AaState;
 
-/* Refines rgba (the pass-0 image, one ray per pixel centre) adaptively: each round marks
- * the leaves that fail the contrast test (threshold s->aa_threshold, floor s->aa_floor)
+/* Refines rgba (the pass-0 image of the frame's window, one ray per pixel centre) adaptively: each
+ * round marks the leaves that fail the contrast test (threshold s->aa_threshold, floor s->aa_floor)
  * against an adjacent leaf at their level or deeper, and splits them in four (three new
  * samples each, traced by r's kernels), until nothing is marked; leaves at s->aa_max_level
  * never split. rgba becomes the mean of each refined pixel's finest cells, each the value of
@@ -51,13 +51,23 @@ typedef struct AaState {
 int aa_refine(AaState *aa, Renderer *r, const Scene *s, float *rgba, RenderStats *st, int progress,
               char *err, size_t errlen);
 
+/* How far beyond a pixel adaptive refinement of s reads, in pixels: each contrast round
+ * reads the 8 neighbours of the pixels it tests, so after the AA_MAX_ROUNDS - min level
+ * rounds there can be at most, a pixel's leaves depend on the pass-0 samples and trees of
+ * the pixels that many pixels around it, and the nearest-sample reconstruction reads the
+ * neighbours' trees once more (+1, whichever reconstruction). A region of the image rendered
+ * with this many pixels around it (clipped to the image) is refined exactly as in the whole
+ * image. 0 without adaptive anti-aliasing (pass 0 and --ssaa read each pixel's own samples
+ * only). */
+int aa_reach(const Scene *s);
+
 /* Whether a frame of s fits r's device before anything is traced: with a minimum level
  * (s->aa_min_level) every pixel takes a tree slot. Returns 0, or 2 with a message in err
  * (as aa_refine would after pass 0). */
 int aa_check_fits(const Renderer *r, const Scene *s, char *err, size_t errlen);
 
-/* Renders rgba with n x n samples at the subpixel centres of every pixel (n in 1..16),
- * box-filtered. Returns as aa_refine. */
+/* Renders rgba, the frame's window, with n x n samples at the subpixel centres of every
+ * pixel (n in 1..16), box-filtered. Returns as aa_refine. */
 int aa_supersample(AaState *aa, Renderer *r, const Scene *s, int n, float *rgba, RenderStats *st,
                    char *err, size_t errlen);
 

@@ -126,7 +126,8 @@ int scene_parse_grid_levels(const char *text, int res[3], int sub[3])
 
 static int load_image(Ctx *c, const cJSON *j, Scene *s)
 {
-    static const char *const keys[] = {"width", "height", "output", "exposure", "background", NULL};
+    static const char *const keys[] = {"width",      "height",      "output", "exposure",
+                                       "background", "environment", NULL};
     static const float black[3] = {0, 0, 0};
     if (json_expect_object(c, j, "image") || json_check_keys(c, j, "image", keys)) return -1;
     if (json_get_int(c, j, "image", "width", 1, SCENE_MAX_IMAGE, 400, 0, &s->width) ||
@@ -141,7 +142,7 @@ static int load_image(Ctx *c, const cJSON *j, Scene *s)
         if (!(s->output = scene_strdup(o->valuestring)))
             return scene_fail(c, NULL, "out of memory");
     }
-    return 0;
+    return scene_load_environment(c, j, s);
 }
 
 static int load_camera(Ctx *c, const cJSON *j, Scene *s)
@@ -330,6 +331,7 @@ static void render_defaults(Scene *s)
     s->aa_reconstruct = SCENE_AA_NEAREST;
     s->aa_pairs = SCENE_AA_PAIRS_FIRST;
     s->ssaa = 1;
+    s->crop_margin = -1;
     s->bands = 8;
     s->band_layout = DISP_LAYOUT_UNIFORM;
     s->shadow_jitter = 1;
@@ -534,6 +536,8 @@ void scene_free(Scene *s)
     free(s->dir);
     free(s->output);
     free(s->lights);
+    free(s->env.file);
+    free(s->env.texels);
     for (int i = 0; s->materials && i < s->nmaterials; i++) free(s->materials[i].pattern.image);
     free(s->materials);
     free(s->objects);

@@ -29,6 +29,16 @@ typedef struct ScenePattern {
     float origin[3], size[3];
 } ScenePattern;
 
+/* image.environment: a latitude-longitude image seen by rays that leave the scene
+ * (docs/scene-format.md; the kernels' VbEnvironment). file NULL: none. */
+typedef struct SceneEnvironment {
+    char *file;         /* the image, joined with the scene's directory */
+    int width, height;  /* texels */
+    float *texels;      /* linear rgba (a = 1), row 0 the top (the zenith); finite, >= 0 */
+    float scale;        /* the radiance multiplier, >= 0 */
+    float to_env[3][3]; /* rows of the world-to-environment rotation */
+} SceneEnvironment;
+
 typedef struct SceneMaterial {
     char name[SCENE_NAME_MAX];
     VbMaterial gpu;
@@ -83,6 +93,7 @@ typedef struct Scene {
     char *output;   /* image.output, or NULL */
     float exposure; /* stops */
     float background[3];
+    SceneEnvironment env; /* image.environment; env.file NULL: none */
     /* camera */
     vec3 eye, look_at, up;
     float fov; /* vertical, degrees */
@@ -123,6 +134,12 @@ typedef struct Scene {
     int aa_reconstruct;   /* SCENE_AA_NEAREST or SCENE_AA_LEAVES */
     int aa_pairs;         /* SCENE_AA_PAIRS_FIRST or SCENE_AA_PAIRS_BOTH */
     int ssaa;             /* uniform N x N supersampling (command line only); 1: off */
+    int crop[4];          /* --crop (command line only): the region written, x0, y0, x1, y1 in
+                           * pixels (x1, y1 one past its last column and row); all 0: none,
+                           * the whole image */
+    int crop_margin;      /* --crop-margin (command line only): pixels rendered around the
+                           * region for adaptive anti-aliasing's contrast test; -1: its whole
+                           * reach (frame_window) */
     int bands;            /* render.bands: wavelength bands of a dispersive split */
     int band_layout;      /* DISP_LAYOUT_*: "bands": "thesis", or by default when every
                            * dispersive material uses the thesis model */

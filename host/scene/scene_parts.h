@@ -1,5 +1,5 @@
 /* scene_parts.h — internal to host/scene/: the stages of scene_load_text, one file each
- * (scene_materials.c, scene_shapes.c, scene_texture.c, scene_objects.c,
+ * (scene_environment.c, scene_materials.c, scene_shapes.c, scene_texture.c, scene_objects.c,
  * scene_animation.c). Each reads one part of the document into the Scene and reports
  * through the Ctx (scene_json.h). Not included outside host/scene/. */
 #ifndef VBCL_SCENE_PARTS_H
@@ -7,6 +7,10 @@
 
 #include "scene.h"
 #include "scene_json.h"
+
+/* image.environment (img: the image object), its file read and checked, into s->env
+ * (scene_environment.c). */
+int scene_load_environment(Ctx *c, const cJSON *img, Scene *s);
 
 /* materials[]: every material, its pattern and dispersion (scene_materials.c). */
 int scene_load_materials(Ctx *c, const cJSON *j, Scene *s);

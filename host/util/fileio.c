@@ -115,41 +115,72 @@ static void sync_dir(const char *path)
     }
 }
 
-int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
-                      char *err, size_t errlen)
+/* What fills a temporary: write through a FILE (file_write_stream), or fill through its
+ * descriptor (file_write_fd), with ctx. */
+typedef struct Filler {
+    void (*write)(FILE *f, const void *ctx);
+    int (*fill)(int fd, void *ctx, char *err, size_t errlen);
+    const void *ctx;
+    void *fill_ctx;
+} Filler;
+
+/* Fills the temporary's descriptor fd as w says. Returns 0; an errno (the first error of
+ * the writes and the flush of what is buffered); or -1 when the filler failed with its own
+ * message in err. The descriptor stays open (*f, when one was made, holds it). */
+static int fill_temp(int fd, FILE **f, const Filler *w, char *err, size_t errlen)
+{
+    if (w->fill) return w->fill(fd, w->fill_ctx, err, errlen) ? -1 : 0;
+    if (!(*f = fdopen(fd, "wb"))) return errno ? errno : EIO;
+    errno = 0;
+    w->write(*f, w->ctx);
+    if (ferror(*f)) return errno ? errno : EIO;
+    return fflush(*f) != 0 ? (errno ? errno : EIO) : 0;
+}
+
+/* Writes path whole or not at all, its temporary filled as w says. */
+static int write_temp(const char *path, const Filler *w, char *err, size_t errlen)
 {
     int slot = temp_begin(path, err, errlen);
     if (slot < 0) return -1;
     const char *tmp = temps[slot].path;
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    /* read and write: an encoder may read back what it wrote */
+    int fd = open(tmp, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && errno == EEXIST) { /* left by a killed process of the same id */
         unlink(tmp);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        fd = open(tmp, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     }
-    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
-    if (!f) {
+    if (fd < 0) {
         int e = errno;
-        if (fd >= 0) close(fd);
         temp_end(slot, 0);
         snprintf(err, errlen, "%s: cannot write: %s", path, strerror(e));
         return -1;
     }
-    errno = 0;
-    write(f, ctx);
-    /* The first error wins: a short write, the flush of what is buffered, the sync to
-     * the disk (where a full disk or quota may show only now), the close. */
-    int saved = ferror(f) ? (errno ? errno : EIO) : 0;
-    if (!saved && fflush(f) != 0) saved = errno ? errno : EIO;
-    if (!saved && fsync(fileno(f)) != 0 && errno != EINVAL) saved = errno;
-    if (fclose(f) != 0 && !saved) saved = errno ? errno : EIO;
+    /* The first error wins: the filling (a short write, the flush of what is buffered),
+     * the sync to the disk (where a full disk or quota may show only now), the close. */
+    FILE *f = NULL;
+    int saved = fill_temp(fd, &f, w, err, errlen);
+    if (!saved && fsync(fd) != 0 && errno != EINVAL) saved = errno;
+    if ((f ? fclose(f) : close(fd)) != 0 && !saved) saved = errno ? errno : EIO;
     if (!saved && rename(tmp, path) != 0) saved = errno;
     temp_end(slot, !saved);
-    if (saved) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(saved));
-        return -1;
-    }
+    if (saved > 0) snprintf(err, errlen, "%s: cannot write: %s", path, strerror(saved));
+    if (saved) return -1;
     sync_dir(path);
     return 0;
+}
+
+int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
+                      char *err, size_t errlen)
+{
+    Filler w = {write, NULL, ctx, NULL};
+    return write_temp(path, &w, err, errlen);
+}
+
+int file_write_fd(const char *path, int (*fill)(int fd, void *ctx, char *err, size_t errlen),
+                  void *ctx, char *err, size_t errlen)
+{
+    Filler w = {NULL, fill, NULL, ctx};
+    return write_temp(path, &w, err, errlen);
 }
 
 /* The bytes of file_write_whole. */

@@ -16,6 +16,14 @@
 int file_write_stream(const char *path, void (*write)(FILE *f, const void *ctx), const void *ctx,
                       char *err, size_t errlen);
 
+/* Writes path as file_write_stream does, the temporary filled through its descriptor:
+ * fill(fd, ctx, err, errlen) writes it (opened for reading and writing; another process
+ * may write it too, given the descriptor) and returns 0, or -1 with a message in err, which
+ * is then file_write_fd's message. The sync, close and rename follow, each checked
+ * ("PATH: cannot write: CAUSE"); on any failure the temporary is removed. */
+int file_write_fd(const char *path, int (*fill)(int fd, void *ctx, char *err, size_t errlen),
+                  void *ctx, char *err, size_t errlen);
+
 /* Writes the n bytes at data to path as file_write_stream does. */
 int file_write_whole(const char *path, const void *data, size_t n, char *err, size_t errlen);
 

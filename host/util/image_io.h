@@ -40,30 +40,48 @@ void image_preload(int thread);
 void image_preload_wait(void);
 
 /* The helper process's main (vbcl --image-helper, started by image_preload): loads the
- * plugin and encodes the images vbcl sends it, sending back the bytes, until vbcl closes
+ * plugin and encodes the images vbcl sends it, each into the descriptor of the file that
+ * came with the request, answering with the result and its message only, until vbcl closes
  * the socket. Returns the exit status. */
 int image_helper_main(void);
 
 /* Writes rgba (4 floats per pixel, linear radiance, alpha ignored) scaled by 2^exposure.
- * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The image is
- * encoded in memory (image_encode; PFM by image_pfm.c) and written by this process through
- * fileio.h: a temporary file in the same directory, every write checked, synced and
- * renamed into place, so an existing file is replaced only by a complete image, and a
- * failed write leaves no temporary. Returns 0, or -1 with a message naming path and the
- * cause ("No space left on device"). */
+ * 8-bit formats get the sRGB transfer curve, clamped; EXR keeps linear floats. The file is
+ * written through fileio.h, whole or not at all: a temporary file in the same directory,
+ * which the encoder writes through its descriptor (image_encode; PFM by image_pfm.c), every
+ * write checked, then synced and renamed into place by this process, so an existing file is
+ * replaced only by a complete image, and a failed write leaves no temporary. Returns 0, or
+ * -1 with a message naming path and the cause ("No space left on device"). */
 int image_write(const char *path, int width, int height, const float *rgba, float exposure,
                 char *err, size_t errlen);
 
 /* Encodes rgba as image_write would write it in path's format (PNG, JPEG, TIFF or EXR, by
- * the extension) into memory: *bytes (malloc'ed) of *n bytes. Nothing is written; path
- * names the image in messages. In the vbcl binary the encoding runs in the image helper
- * process, or on the plugin loaded here (image_plugin.c). Returns 0, or -1 with a message. */
-int image_encode(const char *path, int width, int height, const float *rgba, float exposure,
-                 unsigned char **bytes, size_t *n, char *err, size_t errlen);
+ * the extension) into fd, an empty file open for reading and writing, from offset 0, at
+ * offsets of its own (pwrite: the descriptor's file offset is neither used nor moved).
+ * Neither syncs nor closes fd; path only names the format and the image in messages. In
+ * the vbcl binary the encoding runs in the image helper process, which gets a copy of fd
+ * over its socket, or on the plugin loaded here (image_plugin.c). Returns 0, or -1 with a
+ * message: "PATH: cannot write: CAUSE" when a write failed (as fileio.h says it), else
+ * "PATH: cannot encode the image: ..." and the like. */
+int image_encode(const char *path, int fd, int width, int height, const float *rgba, float exposure,
+                 char *err, size_t errlen);
 
 /* Reads an image as floats, 4 channels per pixel (missing channels 0, alpha 1), values as
  * stored (8-bit images give encoded values in [0, 1]). *rgba is malloc'ed. */
 int image_read(const char *path, int *width, int *height, float **rgba, char *err, size_t errlen);
+
+/* The most texels image_read_radiance reads: 2^28 (16384 x 16384, 4 GiB of floats). */
+#define IMAGE_RADIANCE_MAX_TEXELS ((size_t)1 << 28)
+
+/* Reads an image as linear radiance, 4 floats per pixel (r, g, b, 1), row 0 the top: a grey
+ * image spread over r, g and b; decoded by what OpenImageIO says of its colour space: "sRGB"
+ * (PNG, JPEG) by the sRGB curve, "Rec709" (PNM) by the Rec. 709 curve, "GammaCorrectedG"
+ * raised to G, "Linear" (EXR, HDR) as stored; integer pixels of no stated colour space as
+ * sRGB, float ones as stored. Values are not checked (NaN, negative). An image of no texels
+ * or more than IMAGE_RADIANCE_MAX_TEXELS is refused. *rgba is malloc'ed. Returns 0, or -1
+ * with a message naming path. */
+int image_read_radiance(const char *path, int *width, int *height, float **rgba, char *err,
+                        size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
-/* image_plugin.c — image_encode and image_read of the vbcl binary, by OpenImageIO loaded
- * as a plugin. Debian's OpenImageIO brings some 260 shared libraries, whose symbols the
- * dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render pays
- * before its first ray"); linked into vbcl, every run paid that before main, `--help`
+/* image_plugin.c — image_encode, image_read and image_read_radiance of the vbcl binary, by
+ * OpenImageIO loaded as a plugin. Debian's OpenImageIO brings some 260 shared libraries,
+ * whose symbols the dynamic loader resolves in about 0.4 s (docs/benchmarks.md, "What every render
+ * pays before its first ray"); linked into vbcl, every run paid that before main, `--help`
  * included. Instead image_io.cpp is built into a shared object embedded in the binary
  * (vbcl_image_plugin, Makefile), loaded from an anonymous memory file (memfd_create), or
  * from an unlinked temporary file where there is none, so that the binary stays one file.
@@ -9,14 +9,18 @@
  * A render that writes such an image has it encoded by a helper process: image_preload
  * starts vbcl again as `vbcl --image-helper` (image_helper_main), which loads the plugin
  * while this process opens its devices, builds its kernels and renders; image_encode sends
- * it the pixels and gets back the file's bytes, which this process writes (image_write.c),
- * so that the file's owner checks the write and removes its temporary.
+ * it the pixels with a copy of the descriptor of the file's temporary (SCM_RIGHTS), into
+ * which the helper encodes the image, answering with the result and a message only. This
+ * process made the temporary and syncs, renames or removes it (image_write.c, fileio.h), so
+ * that the file's owner checks the write and no temporary outlives a failure. A helper that
+ * dies, does not answer in time or is gone leaves the image to this process, which empties
+ * the temporary and encodes into it itself.
  * Loaded on a thread of this process instead, the plugin held up the kernels' build from
  * source for as long as it loaded (the dynamic loader serves one thread at a time:
  * docs/benchmarks.md, "OpenImageIO in a process of its own"). Where the helper cannot
- * start, with VBCL_IMAGE_HELPER=0, and for image_read (textures, before any device is
- * open), the plugin loads here, on a thread of its own (image_preload) or at the first
- * call. */
+ * start, with VBCL_IMAGE_HELPER=0, and for the reads (textures, environments; before any
+ * device is open), the plugin loads here, on a thread of its own (image_preload) or at the
+ * first call. */
 #include "image_io.h"
 
 #include "diag.h"
@@ -43,8 +47,7 @@ extern char **environ;
 /* The plugin's bytes (image_plugin_blob.o, which the Makefile makes). */
 extern const unsigned char vbcl_image_plugin[], vbcl_image_plugin_end[];
 
-typedef int (*EncodeFn)(const char *, int, int, const float *, float, unsigned char **, size_t *,
-                        char *, size_t);
+typedef int (*EncodeFn)(const char *, int, int, int, const float *, float, char *, size_t);
 typedef int (*ReadFn)(const char *, int *, int *, float **, char *, size_t);
 
 static pthread_mutex_t plugin_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -52,7 +55,7 @@ static pthread_cond_t plugin_loaded = PTHREAD_COND_INITIALIZER;
 static struct {
     int state; /* PLUGIN_NONE, _LOADING (on the preload thread) or _DONE (tried) */
     EncodeFn encode;
-    ReadFn read;
+    ReadFn read, read_radiance;
     char err[512]; /* why it failed */
 } plugin;
 enum { PLUGIN_NONE = 0, PLUGIN_LOADING = 1, PLUGIN_DONE = 2 };
@@ -91,7 +94,7 @@ static int plugin_file(void)
     return fd;
 }
 
-/* Loads the plugin and finds its two functions; on failure says why in plugin.err. */
+/* Loads the plugin and finds its three functions; on failure says why in plugin.err. */
 static void plugin_load(void)
 {
     int fd = plugin_file();
@@ -106,10 +109,12 @@ static void plugin_load(void)
     }
     plugin.encode = (EncodeFn)dlsym(h, "image_encode");
     plugin.read = (ReadFn)dlsym(h, "image_read");
-    if (!plugin.encode || !plugin.read) {
+    plugin.read_radiance = (ReadFn)dlsym(h, "image_read_radiance");
+    if (!plugin.encode || !plugin.read || !plugin.read_radiance) {
         snprintf(plugin.err, sizeof plugin.err, "its functions are missing");
         plugin.encode = NULL;
         plugin.read = NULL;
+        plugin.read_radiance = NULL;
     }
 }
 
@@ -148,7 +153,7 @@ static void preload_thread(void)
 
 /* The helper process: its pid and this end of the socket to it (-1: none). */
 #define HELPER_FD    63 /* the socket's descriptor in the helper */
-#define HELPER_MAGIC 0x76626931u
+#define HELPER_MAGIC 0x76626932u
 static pthread_mutex_t helper_lock = PTHREAD_MUTEX_INITIALIZER;
 static struct {
     pid_t pid;
@@ -157,9 +162,10 @@ static struct {
     int stuck; /* it did not answer within helper_timeout_ms */
 } helper = {0, -1, 0, 0};
 
-/* An encoding request: the header, then path_len bytes of path (whose extension names the
+/* An encoding request: the header, with the descriptor of the file to encode into attached
+ * to its bytes (SCM_RIGHTS), then path_len bytes of path (whose extension names the
  * format), then width * height * 4 floats. The reply: rc (0 or -1), then err_len bytes of
- * message and bytes bytes of the encoded image. */
+ * message; the image is in the file. */
 typedef struct {
     uint32_t magic;
     int32_t width, height;
@@ -169,12 +175,58 @@ typedef struct {
 typedef struct {
     int32_t rc;
     uint32_t err_len;
-    uint64_t bytes;
 } HelperReply;
 
+/* The control message that carries one descriptor, and room for it. */
+typedef union {
+    char buf[CMSG_SPACE(sizeof(int))];
+    struct cmsghdr align;
+} FdControl;
+
+/* Sends or receives up to n bytes at p in one call (send or recv's result). pass, where not
+ * NULL, is a descriptor: sending, a copy of *pass goes with the bytes (SCM_RIGHTS) unless it
+ * is -1, and is -1 once sent; receiving, one that came with them lands there
+ * (close-on-exec). */
+static ssize_t sock_move(int fd, char *p, size_t n, int sending, int flags, int *pass)
+{
+    FdControl ctl;
+    memset(&ctl, 0, sizeof ctl);
+    struct iovec iov = {p, n};
+    struct msghdr m = {.msg_iov = &iov, .msg_iovlen = 1};
+    if (pass && (!sending || *pass >= 0)) {
+        m.msg_control = ctl.buf;
+        m.msg_controllen = sizeof ctl.buf;
+    }
+    if (sending && m.msg_control) {
+        struct cmsghdr *c = CMSG_FIRSTHDR(&m);
+        c->cmsg_level = SOL_SOCKET;
+        c->cmsg_type = SCM_RIGHTS;
+        c->cmsg_len = CMSG_LEN(sizeof(int));
+        memcpy(CMSG_DATA(c), pass, sizeof(int));
+    }
+    ssize_t k =
+        sending ? sendmsg(fd, &m, MSG_NOSIGNAL | flags) : recvmsg(fd, &m, MSG_CMSG_CLOEXEC | flags);
+    if (k > 0 && sending && m.msg_control) *pass = -1;
+    for (struct cmsghdr *c = !sending && k > 0 && m.msg_control ? CMSG_FIRSTHDR(&m) : NULL; c;
+         c = CMSG_NXTHDR(&m, c)) {
+        int got;
+        if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_RIGHTS ||
+            c->cmsg_len != CMSG_LEN(sizeof(int)))
+            continue;
+        memcpy(&got, CMSG_DATA(c), sizeof got);
+        if (*pass < 0)
+            *pass = got;
+        else
+            close(got); /* one descriptor a request */
+    }
+    return k;
+}
+
 /* Sends or receives all n bytes, waiting at most timeout_ms (-1: forever) for each part to
- * move; 0, -1 on an error or the other end gone, or -3 when the wait ran out. */
-static int sock_all_within(int fd, void *buf, size_t n, int sending, int timeout_ms)
+ * move; 0, -1 on an error or the other end gone, or -3 when the wait ran out. pass: a
+ * descriptor that goes with the bytes, or NULL (sock_move; receiving, *pass is -1 at the
+ * start, and the caller closes what came, whatever the result). */
+static int sock_all_within(int fd, void *buf, size_t n, int sending, int timeout_ms, int *pass)
 {
     char *p = buf;
     while (n > 0) {
@@ -184,8 +236,7 @@ static int sock_all_within(int fd, void *buf, size_t n, int sending, int timeout
         if (ready == 0) return -3;
         if (ready < 0) return -1;
         /* with a bound, never block in the call: it moves what fits and poll waits again */
-        int flags = timeout_ms < 0 ? 0 : MSG_DONTWAIT;
-        ssize_t k = sending ? send(fd, p, n, MSG_NOSIGNAL | flags) : recv(fd, p, n, flags);
+        ssize_t k = sock_move(fd, p, n, sending, timeout_ms < 0 ? 0 : MSG_DONTWAIT, pass);
         if (k < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
         if (k <= 0) return -1;
         p += k;
@@ -196,7 +247,7 @@ static int sock_all_within(int fd, void *buf, size_t n, int sending, int timeout
 
 static int sock_all(int fd, void *buf, size_t n, int sending)
 {
-    return sock_all_within(fd, buf, n, sending, -1);
+    return sock_all_within(fd, buf, n, sending, -1, NULL);
 }
 
 /* How long vbcl waits for the helper to take or give the next bytes before it ends it and
@@ -263,37 +314,25 @@ void image_preload(int thread)
 }
 
 /* image_encode through the helper: 0, -1 with its message, or -2 when there is no helper
- * or it is gone (then the caller encodes here). */
-static int helper_encode(const char *path, int width, int height, const float *rgba, float exposure,
-                         unsigned char **out, size_t *nout, char *err, size_t errlen)
+ * or it is gone (then the caller encodes here, the helper ended: it writes no more). */
+static int helper_encode(const char *path, int file, int width, int height, const float *rgba,
+                         float exposure, char *err, size_t errlen)
 {
     pthread_mutex_lock(&helper_lock);
     int rc = -2, t = helper_timeout_ms(), s = -1;
     size_t plen = strlen(path), bytes = sizeof(float) * 4 * (size_t)width * (size_t)height;
     HelperRequest q = {HELPER_MAGIC, width, height, exposure, (uint32_t)plen};
     HelperReply a;
-    if (helper.fd >= 0 && !(s = sock_all_within(helper.fd, &q, sizeof q, 1, t)) &&
-        !(s = sock_all_within(helper.fd, (void *)path, plen, 1, t)) &&
-        !(s = sock_all_within(helper.fd, (void *)rgba, bytes, 1, t)) &&
-        !(s = sock_all_within(helper.fd, &a, sizeof a, 0, t)) && a.err_len < 4096 &&
-        a.bytes <= SIZE_MAX) {
-        char msg[4096];
-        unsigned char *data = a.bytes ? malloc((size_t)a.bytes) : NULL;
-        if (a.bytes && !data) {
-            snprintf(err, errlen, "%s: out of memory for the encoded image (%llu bytes)", path,
-                     (unsigned long long)a.bytes);
-            rc = -1;
-            helper.stuck = 1; /* its reply cannot be read: it is ended (and reaped) below */
-        } else if (!(s = sock_all_within(helper.fd, msg, a.err_len, 0, t)) &&
-                   !(s = sock_all_within(helper.fd, data, (size_t)a.bytes, 0, t))) {
-            msg[a.err_len] = 0;
-            if (a.rc) snprintf(err, errlen, "%s", msg);
-            rc = a.rc ? -1 : 0;
-            *out = data;
-            *nout = (size_t)a.bytes;
-            data = NULL;
-        }
-        free(data);
+    char msg[4096];
+    int pass = file; /* the copy of the file's descriptor that goes with the request */
+    if (helper.fd >= 0 && !(s = sock_all_within(helper.fd, &q, sizeof q, 1, t, &pass)) &&
+        !(s = sock_all_within(helper.fd, (void *)path, plen, 1, t, NULL)) &&
+        !(s = sock_all_within(helper.fd, (void *)rgba, bytes, 1, t, NULL)) &&
+        !(s = sock_all_within(helper.fd, &a, sizeof a, 0, t, NULL)) && a.err_len < sizeof msg &&
+        !(s = sock_all_within(helper.fd, msg, a.err_len, 0, t, NULL))) {
+        msg[a.err_len] = 0;
+        if (a.rc) snprintf(err, errlen, "%s", msg);
+        rc = a.rc ? -1 : 0;
     }
     if (s == -3) {
         helper.stuck = 1;
@@ -309,8 +348,9 @@ static int helper_encode(const char *path, int width, int height, const float *r
 }
 
 /* `vbcl --image-helper`: loads the plugin, then encodes each image the socket on
- * HELPER_FD asks for and answers with image_encode's result and bytes, until the socket
- * closes. It writes no file: vbcl does (image_write.c). */
+ * HELPER_FD asks for into the file whose descriptor came with the request, and answers
+ * with image_encode's result and message, until the socket closes. It neither syncs nor
+ * renames the file: vbcl does (image_write.c). */
 int image_helper_main(void)
 {
     HelperRequest q;
@@ -319,34 +359,42 @@ int image_helper_main(void)
         fprintf(stderr, "vbcl: --image-helper is vbcl's own helper, not an option\n");
         return 2;
     }
+    /* A file-size limit (ulimit -f) must fail the write with EFBIG, which the message
+     * names, not kill the helper mid-write (main ignores it too; an ignored signal stays
+     * ignored across the exec that started the helper). */
+    signal(SIGXFSZ, SIG_IGN);
     plugin_load();
-    while (!sock_all(HELPER_FD, &q, sizeof q, 0)) {
-        if (q.magic != HELPER_MAGIC || q.width <= 0 || q.height <= 0 || q.path_len == 0 ||
-            q.path_len > 4095 || (size_t)q.width > SIZE_MAX / 16 / (size_t)q.height)
+    for (;;) {
+        int file = -1;
+        if (sock_all_within(HELPER_FD, &q, sizeof q, 0, -1, &file)) {
+            if (file >= 0) close(file);
+            return 0; /* vbcl closed the socket: done */
+        }
+        if (file < 0 || q.magic != HELPER_MAGIC || q.width <= 0 || q.height <= 0 ||
+            q.path_len == 0 || q.path_len > 4095 ||
+            (size_t)q.width > SIZE_MAX / 16 / (size_t)q.height) {
+            if (file >= 0) close(file);
             return 1;
+        }
         char path[4096], err[1024] = "";
         size_t bytes = sizeof(float) * 4 * (size_t)q.width * (size_t)q.height;
         float *rgba = malloc(bytes);
         if (!rgba || sock_all(HELPER_FD, path, q.path_len, 0) ||
             sock_all(HELPER_FD, rgba, bytes, 0)) {
             free(rgba);
+            close(file);
             return 1;
         }
         path[q.path_len] = 0;
-        unsigned char *data = NULL;
-        size_t n = 0;
-        int rc = plugin.encode ? plugin.encode(path, q.width, q.height, rgba, q.exposure, &data, &n,
-                                               err, sizeof err)
+        int rc = plugin.encode ? plugin.encode(path, file, q.width, q.height, rgba, q.exposure, err,
+                                               sizeof err)
                                : plugin_missing(path, err, sizeof err);
         free(rgba);
-        HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u, rc ? 0u : (uint64_t)n};
-        int sent = !sock_all(HELPER_FD, &a, sizeof a, 1) &&
-                   !sock_all(HELPER_FD, err, a.err_len, 1) &&
-                   !sock_all(HELPER_FD, data, (size_t)a.bytes, 1);
-        free(data);
-        if (!sent) return 1;
+        close(file);
+        HelperReply a = {rc ? -1 : 0, rc ? (uint32_t)strlen(err) : 0u};
+        if (sock_all(HELPER_FD, &a, sizeof a, 1) || sock_all(HELPER_FD, err, a.err_len, 1))
+            return 1;
     }
-    return 0;
 }
 
 void image_preload_wait(void)
@@ -371,24 +419,34 @@ static int plugin_ready(const char *path, char *err, size_t errlen)
     return ok ? 0 : plugin_missing(path, err, errlen);
 }
 
-int image_encode(const char *path, int width, int height, const float *rgba, float exposure,
-                 unsigned char **bytes, size_t *n, char *err, size_t errlen)
+int image_encode(const char *path, int fd, int width, int height, const float *rgba, float exposure,
+                 char *err, size_t errlen)
 {
-    *bytes = NULL;
-    *n = 0;
     pthread_mutex_lock(&plugin_lock);
     int here = plugin.state != PLUGIN_NONE; /* loaded, or loading, in this process */
     pthread_mutex_unlock(&plugin_lock);
     if (!here) {
-        int rc = helper_encode(path, width, height, rgba, exposure, bytes, n, err, errlen);
+        int rc = helper_encode(path, fd, width, height, rgba, exposure, err, errlen);
         if (rc != -2) return rc;
+        /* whatever a helper wrote before it died or was ended goes: the file starts empty */
+        if (ftruncate(fd, 0) != 0) {
+            snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+            return -1;
+        }
     }
     if (plugin_ready(path, err, errlen)) return -1;
-    return plugin.encode(path, width, height, rgba, exposure, bytes, n, err, errlen);
+    return plugin.encode(path, fd, width, height, rgba, exposure, err, errlen);
 }
 
 int image_read(const char *path, int *width, int *height, float **rgba, char *err, size_t errlen)
 {
     if (plugin_ready(path, err, errlen)) return -1;
     return plugin.read(path, width, height, rgba, err, errlen);
+}
+
+int image_read_radiance(const char *path, int *width, int *height, float **rgba, char *err,
+                        size_t errlen)
+{
+    if (plugin_ready(path, err, errlen)) return -1;
+    return plugin.read_radiance(path, width, height, rgba, err, errlen);
 }
