@@ -1,35 +1,23 @@
 #line 2 "geometry.cl"
-/* geometry.cl — robust ray origins (Waechter & Binder 2019), watertight ray/triangle
- * intersection (Woop, Benthin & Wald 2013), triangle access and the closest-hit rule. */
+/* geometry.cl — ray origins off their surface by the error bound of the hit point (pbrt-v4),
+ * watertight ray/triangle intersection (Woop, Benthin & Wald 2013), triangle access and the
+ * closest-hit rule. */
 #ifndef VBCL_GEOMETRY_CL
 #define VBCL_GEOMETRY_CL
 
+#include "offset.h"
 #include "types.h"
 
-/* Moves a point p on a surface off it along the geometric normal n (pointing to the
- * side the new ray leaves into), so that a ray from the result cannot hit the surface it
- * starts on, at any scene scale (Waechter & Binder 2019): a few ulps of p's own magnitude,
- * and at least about 16 ulps of `scale`, the largest vertex coordinate of p's triangle —
- * the rounding error of a point interpolated on a large triangle grows with its vertices,
- * not with |p|, so near the origin the first rule alone is too small. */
-VB_INLINE float3 ray_offset_origin(float3 p, float3 n, float scale)
+/* Moves a point p on a surface off it along the unit geometric normal n (pointing to the
+ * side the new ray leaves into) by err, 16 times the bound of p's distance from the surface's
+ * plane (tri_point_error), and one float further in each coordinate that moves (offset.h,
+ * after pbrt-v4's OffsetRayOrigin): a ray from the result cannot hit the triangle it starts
+ * on, at any scene scale or position, and moves as far as the point's own rounding says. */
+VB_INLINE float3 ray_offset_origin(float3 p, float3 n, float err)
 {
-    const float origin = 1.0f / 32.0f;
-    const float float_scale = 1.0f / 65536.0f;
-    const float int_scale = 256.0f;
-    int3 of_i = convert_int3(int_scale * n);
-    int3 neg = isless(p, (float3)(0.0f));
-    float3 p_i = as_float3(as_int3(p) + select(of_i, -of_i, neg));
-    float3 p_f = p + float_scale * n;
-    float3 q = select(p_i, p_f, isless(fabs(p), (float3)(origin)));
-    float need = scale * (1.0f / 1048576.0f);
-    return dot(q - p, n) >= need ? q : p + need * n;
+    return (float3)(vb_offset_coord(p.x, n.x, err), vb_offset_coord(p.y, n.y, err),
+                    vb_offset_coord(p.z, n.z, err));
 }
-
-/* The largest vertex coordinate of a triangle, in magnitude: the scale of its rounding. */
-#define TRI_SCALE(tris, tri)                                                                       \
-    vb_max3(fmax(fabs(tri_vertex(tris, tri, 0).xyz),                                               \
-                 fmax(fabs(tri_vertex(tris, tri, 1).xyz), fabs(tri_vertex(tris, tri, 2).xyz))))
 
 /* Per-ray constants of the watertight test (Woop, Benthin & Wald 2013): the axis
  * permutation that makes the largest direction component z (kx, ky, kz) and the shear
@@ -91,10 +79,16 @@ VB_INLINE void ray_shear_apply(const RayShear *r, float4 p, float *x, float *y, 
     *z = r->sz * qz;
 }
 
+/* tri_finish's answer for a hit closer than its own rounding-error bound, where the device
+ * has cl_khr_fp64: the caller decides it again in double (tri_close_double). */
+#define TRI_CLOSE 2
+
 /* The watertight test of a triangle whose vertices went through the ray's shear
  * (ax .. cz) and whose edge functions are U = cx by - cy bx, V = ax cy - ay cx and
  * W = bx ay - by ax: tri_intersect from there on. For the triangles of a leaf quad
- * (grid.cl), which computes the same values four at a time. */
+ * (grid.cl), which computes the same values four at a time. Returns 1 for a hit, 0 for
+ * none, and TRI_CLOSE (t, u and v written) for a hit within the bound of its distance's
+ * rounding error (without cl_khr_fp64: 0). */
 VB_INLINE int tri_finish(float ax, float ay, float az, float bx, float by, float bz, float cx,
                          float cy, float cz, float U, float V, float W, float tmax, float *t_out,
                          float *u_out, float *v_out)
@@ -117,9 +111,9 @@ VB_INLINE int tri_finish(float ax, float ay, float az, float bx, float by, float
     }
     float rcp = 1.0f / det;
     float t = T * rcp;
-    /* Reject hits closer than the rounding error of the sheared computation (Pharr, Jakob
-     * & Humphreys, pbrt 3rd ed., 3.9.6): a ray leaving a large triangle near the origin
-     * must not find that triangle again. */
+    /* Hits closer than the rounding error of the sheared computation (Pharr, Jakob &
+     * Humphreys, pbrt 3rd ed., 3.9.6) are not taken as they are: a ray leaving a triangle
+     * from its offset origin must not find that triangle again. They go to double. */
     const float g2 = 2.0f * 5.9604645e-8f / (1.0f - 2.0f * 5.9604645e-8f);
     const float g3 = 3.0f * 5.9604645e-8f / (1.0f - 3.0f * 5.9604645e-8f);
     const float g5 = 5.0f * 5.9604645e-8f / (1.0f - 5.0f * 5.9604645e-8f);
@@ -130,12 +124,74 @@ VB_INLINE int tri_finish(float ax, float ay, float az, float bx, float by, float
     float delta_e = 2.0f * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
     float max_e = fmax(fabs(U), fmax(fabs(V), fabs(W)));
     float delta_t = 3.0f * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) * fabs(rcp);
-    if (!(t > delta_t)) return 0;
     *t_out = t;
     *u_out = V * rcp;
     *v_out = W * rcp;
+    if (t > delta_t) return 1;
+#ifdef cl_khr_fp64
+    return TRI_CLOSE;
+#else
+    return 0;
+#endif
+}
+
+#ifdef cl_khr_fp64
+/* A hit that tri_finish found within its float error bound (TRI_CLOSE), decided again from
+ * the triangle's own vertices (a, b, c) with the ray's shear (origin o, permutation k,
+ * shear s) and the edge functions in double, whose bound (the same terms, u = 2^-53) is 2^29
+ * times smaller: a ray that starts near a long, thin triangle (the side of a flat box, whose
+ * float bound spans a good part of the box) finds the edge it crosses there, and a ray from
+ * an offset origin (ray_offset_origin), beyond its own triangle's plane by 16 times the
+ * point's float error bound, still does not find its own. The edge signs stay the float test's.
+ * Returns the hit's t, or 0 for none. Rare, and kept out of line (noinline, cold): inlined into
+ * every lane of the quad loops it made the bench scenes' kernels 13 - 22% slower. */
+__attribute__((noinline, cold)) float tri_close_double(float ox, float oy, float oz, uint kx,
+                                                       uint ky, uint kz, float sx, float sy,
+                                                       float sz, float4 a4, float4 b4, float4 c4,
+                                                       float tmax)
+{
+    double p[9];
+    float4 v[3] = {a4, b4, c4};
+    for (int k = 0; k < 3; k++) {
+        double dx = (double)v[k].x - (double)ox, dy = (double)v[k].y - (double)oy,
+               dz = (double)v[k].z - (double)oz;
+        double qx = kx == 0u ? dx : (kx == 1u ? dy : dz);
+        double qy = ky == 0u ? dx : (ky == 1u ? dy : dz);
+        double qz = kz == 0u ? dx : (kz == 1u ? dy : dz);
+        p[3 * k] = qx - (double)sx * qz;
+        p[3 * k + 1] = qy - (double)sy * qz;
+        p[3 * k + 2] = (double)sz * qz;
+    }
+    double U = p[6] * p[4] - p[7] * p[3], V = p[0] * p[7] - p[1] * p[6],
+           W = p[3] * p[1] - p[4] * p[0];
+    double det = U + V + W;
+    if (det == 0.0) return 0.0f;
+    double t = (U * p[2] + V * p[5] + W * p[8]) / det;
+    const double u = 1.1102230246251565e-16; /* 2^-53 */
+    const double g2 = 2.0 * u / (1.0 - 2.0 * u), g3 = 3.0 * u / (1.0 - 3.0 * u),
+                 g5 = 5.0 * u / (1.0 - 5.0 * u);
+    double max_x = fmax(fabs(p[0]), fmax(fabs(p[3]), fabs(p[6])));
+    double max_y = fmax(fabs(p[1]), fmax(fabs(p[4]), fabs(p[7])));
+    double max_z = fmax(fabs(p[2]), fmax(fabs(p[5]), fabs(p[8])));
+    double delta_x = g5 * (max_x + max_z), delta_y = g5 * (max_y + max_z), delta_z = g3 * max_z;
+    double delta_e = 2.0 * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    double max_e = fmax(fabs(U), fmax(fabs(V), fabs(W)));
+    double delta_t = 3.0 * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) / fabs(det);
+    if (!(t > delta_t) || t > (double)tmax) return 0.0f;
+    return (float)t;
+}
+
+/* tri_close_double for the ray of r: 1 with *t_out, or 0. */
+VB_INLINE int tri_close(const RayShear *r, float4 a4, float4 b4, float4 c4, float tmax,
+                        float *t_out)
+{
+    float t = tri_close_double(r->ox, r->oy, r->oz, r->kx, r->ky, r->kz, r->sx, r->sy, r->sz, a4,
+                               b4, c4, tmax);
+    if (!(t > 0.0f)) return 0;
+    *t_out = t;
     return 1;
 }
+#endif
 
 /* Intersects the sheared ray with triangle (a, b, c). On a hit with 0 < t < tmax
  * returns 1 and writes t and the barycentric weights of b (u) and c (v). Rays through
@@ -150,7 +206,11 @@ VB_INLINE int tri_intersect(const RayShear *r, float4 a4, float4 b4, float4 c4, 
     float U = cx * by - cy * bx;
     float V = ax * cy - ay * cx;
     float W = bx * ay - by * ax;
-    return tri_finish(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, tmax, t_out, u_out, v_out);
+    int hit = tri_finish(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, tmax, t_out, u_out, v_out);
+#ifdef cl_khr_fp64
+    if (hit == TRI_CLOSE) hit = tri_close(r, a4, b4, c4, tmax, t_out);
+#endif
+    return hit;
 }
 
 /* Vertex k (0, 1, 2) of a triangle, read from its own array (indexing past v0 into v1
@@ -185,6 +245,19 @@ VB_INLINE float3 tri_point(__global const VbTriangle *tris, VbHit h)
            h.u * tri_vertex(tris, h.tri, 1).xyz + h.v * tri_vertex(tris, h.tri, 2).xyz;
 }
 
+/* The offset for ray_offset_origin from a hit's point (tri_point) on the triangle whose unit
+ * normal is n (either side): 16 times the bound of the point's distance from the plane, the
+ * interpolation's error, from the magnitudes of its terms (offset.h). */
+VB_INLINE float tri_point_error(__global const VbTriangle *tris, VbHit h, float3 n)
+{
+    float w0 = 1.0f - h.u - h.v;
+    float3 a = tri_vertex(tris, h.tri, 0).xyz, b = tri_vertex(tris, h.tri, 1).xyz,
+           c = tri_vertex(tris, h.tri, 2).xyz;
+    return vb_offset_error(n.x, n.y, n.z, vb_offset_sum(w0, h.u, h.v, a.x, b.x, c.x),
+                           vb_offset_sum(w0, h.u, h.v, a.y, b.y, c.y),
+                           vb_offset_sum(w0, h.u, h.v, a.z, b.z, c.z));
+}
+
 /* Surfaces in contact: a glass prism standing on a floor has its bottom face in the
  * floor's plane, and a ray leaving the glass there hits both at the same distance up to
  * rounding. Were the winner a coin toss per ray, the ray that first crossed the glass
@@ -193,8 +266,9 @@ VB_INLINE float3 tri_point(__global const VbTriangle *tris, VbHit h)
  * here, in every closest-hit search: within this window of the closest hit, an opaque
  * surface (VBCL_TAG_OPAQUE) comes before a medium boundary, so the ray meets the floor
  * while still in the glass, as light does where glass touches a floor. The window is 2^-16
- * of the distances involved (about 128 ulps, the order of the ray offsets, which skip any
- * thinner gap anyway), far below a gap a scene means. */
+ * of the magnitudes of the computation, the ray's distance and its origin (about 128 ulps of
+ * them: above the rounding of the two distances, a few ulps each (tri_finish), and of the two
+ * surfaces' vertices), so the same at any scale; far below a gap a scene means. */
 VB_INLINE float hit_contact_window(float3 org, float t)
 {
     return (1.0f / 65536.0f) * (t + vb_max3(fabs(org)));

@@ -286,22 +286,36 @@ VB_INLINE float vb_lane4(float4 v, int l)
     return l == 0 ? v.s0 : (l == 1 ? v.s1 : (l == 2 ? v.s2 : v.s3));
 }
 
-/* tri_intersect of the triangle in lane l of a quad within tmax, finished from the values
- * quad_candidates kept: no second read of the triangle, no second shear. */
-VB_INLINE int quad_lane_hit(const QuadShear *qs, int l, float tmax, float *t, float *u, float *v)
+/* tri_intersect of triangle tri in lane l of a quad within tmax, finished from the values
+ * quad_candidates kept: no second read of the triangle, no second shear (but for a hit
+ * closer than the float test's error bound, decided in double from its vertices). */
+VB_INLINE int quad_lane_hit(const RayShear *rs, const QuadShear *qs, int l,
+                            __global const VbTriangle *tris, int tri, float tmax, float *t,
+                            float *u, float *v)
 {
-    return tri_finish(vb_lane4(qs->ax, l), vb_lane4(qs->ay, l), vb_lane4(qs->az, l),
-                      vb_lane4(qs->bx, l), vb_lane4(qs->by, l), vb_lane4(qs->bz, l),
-                      vb_lane4(qs->cx, l), vb_lane4(qs->cy, l), vb_lane4(qs->cz, l),
-                      vb_lane4(qs->U, l), vb_lane4(qs->V, l), vb_lane4(qs->W, l), tmax, t, u, v);
+    int hit = tri_finish(vb_lane4(qs->ax, l), vb_lane4(qs->ay, l), vb_lane4(qs->az, l),
+                         vb_lane4(qs->bx, l), vb_lane4(qs->by, l), vb_lane4(qs->bz, l),
+                         vb_lane4(qs->cx, l), vb_lane4(qs->cy, l), vb_lane4(qs->cz, l),
+                         vb_lane4(qs->U, l), vb_lane4(qs->V, l), vb_lane4(qs->W, l), tmax, t, u, v);
+#ifdef cl_khr_fp64
+    if (hit == TRI_CLOSE)
+        hit = tri_close(rs, tri_vertex(tris, tri, 0), tri_vertex(tris, tri, 1),
+                        tri_vertex(tris, tri, 2), tmax, t);
+#else
+    (void)rs;
+    (void)tris;
+    (void)tri;
+#endif
+    return hit;
 }
 
 /* closest_test of triangle tri, in lane l of a quad. */
-VB_INLINE void closest_lane(const QuadShear *qs, int l, float3 org, float tmax,
+VB_INLINE void closest_lane(const RayShear *rs, const QuadShear *qs, int l, float3 org, float tmax,
                             __global const VbTriangle *tris, int tri, Closest *c)
 {
     float t, u, v;
-    if (quad_lane_hit(qs, l, c->reach, &t, &u, &v)) closest_offer(org, tmax, tris, tri, t, u, v, c);
+    if (quad_lane_hit(rs, qs, l, tris, tri, c->reach, &t, &u, &v))
+        closest_offer(org, tmax, tris, tri, t, u, v, c);
 }
 
 /* The triangles of a quad, one index per lane (-1: padding). */
@@ -327,10 +341,10 @@ VB_INLINE uint quad_closest(const RayShear *rs, float3 org, float tmax,
     int4 real = id >= 0;
     QuadShear qs;
     int4 cand = quad_candidates(rs, q, c->reach, &qs) & real;
-    if (cand.s0) closest_lane(&qs, 0, org, tmax, tris, id.s0, c);
-    if (cand.s1) closest_lane(&qs, 1, org, tmax, tris, id.s1, c);
-    if (cand.s2) closest_lane(&qs, 2, org, tmax, tris, id.s2, c);
-    if (cand.s3) closest_lane(&qs, 3, org, tmax, tris, id.s3, c);
+    if (cand.s0) closest_lane(rs, &qs, 0, org, tmax, tris, id.s0, c);
+    if (cand.s1) closest_lane(rs, &qs, 1, org, tmax, tris, id.s1, c);
+    if (cand.s2) closest_lane(rs, &qs, 2, org, tmax, tris, id.s2, c);
+    if (cand.s3) closest_lane(rs, &qs, 3, org, tmax, tris, id.s3, c);
     return vb_count4(real);
 }
 
@@ -429,10 +443,10 @@ VB_INLINE int quads_any(const RayShear *rs, float tmax, __global const VbTriangl
         QuadShear qs;
         int4 cand = quad_candidates(rs, q, tmax, &qs) & real;
         float t, u, v;
-        if ((cand.s0 && quad_lane_hit(&qs, 0, tmax, &t, &u, &v)) ||
-            (cand.s1 && quad_lane_hit(&qs, 1, tmax, &t, &u, &v)) ||
-            (cand.s2 && quad_lane_hit(&qs, 2, tmax, &t, &u, &v)) ||
-            (cand.s3 && quad_lane_hit(&qs, 3, tmax, &t, &u, &v)))
+        if ((cand.s0 && quad_lane_hit(rs, &qs, 0, tris, id.s0, tmax, &t, &u, &v)) ||
+            (cand.s1 && quad_lane_hit(rs, &qs, 1, tris, id.s1, tmax, &t, &u, &v)) ||
+            (cand.s2 && quad_lane_hit(rs, &qs, 2, tris, id.s2, tmax, &t, &u, &v)) ||
+            (cand.s3 && quad_lane_hit(rs, &qs, 3, tris, id.s3, tmax, &t, &u, &v)))
             return 1;
     }
     return 0;

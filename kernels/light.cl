@@ -37,7 +37,7 @@ typedef struct ShadePoint {
     uint material;
     uint key;        /* decorrelates this point's random jitter */
     VbMedium medium; /* the medium on the viewer's side, where shadow feelers start */
-    float scale;     /* largest vertex coordinate of the triangle: sizes the ray offsets */
+    float err;       /* the ray offsets: 16 bounds of p's distance from its plane (offset.h) */
     int object;      /* the object whose surface it is, or -1: not known, or a texture's */
     int tri;         /* the triangle it lies on, or -1: not known */
     int front;       /* ng is the triangle's own normal (outward, on a closed object) */
@@ -159,7 +159,7 @@ VB_INLINE LightShading light_shading_make(__global const VbMaterial *m, float3 d
 #else
     (void)m;
 #endif
-    ls.origin = ray_offset_origin(sp->p, sp->ng, sp->scale);
+    ls.origin = ray_offset_origin(sp->p, sp->ng, sp->err);
     return ls;
 }
 

@@ -107,7 +107,7 @@ VB_INLINE int medium_trace(const DevScene *sc, const ObjectSet *os, float3 org, 
         *state = c.after;
         (*passes)++;
         float3 ng = tri_normal(sc->tris, h.tri);
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, tri_point_error(sc->tris, h, ng));
     }
     return 0;
 }
@@ -191,7 +191,7 @@ VB_INLINE float3 medium_shadow_transmittance(const DevScene *sc, const ObjectSet
         state = c.after;
         left -= seg;
         if (left_sole) return trans * medium_absorb(sc, medium_material(sc, state), left);
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, tri_point_error(sc->tris, h, ng));
     }
     return (float3)(0.0f);
 }

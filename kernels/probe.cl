@@ -89,7 +89,7 @@ __kernel void probe_shade_points(SCENE_KERNEL_ARGS __global const float *points,
     sp.material = 0;
     sp.key = vb_hash((uint)i);
     sp.medium = f->camera_medium;
-    sp.scale = 0.0f;
+    sp.err = vb_offset_error(sp.ng.x, sp.ng.y, sp.ng.z, fabs(sp.p.x), fabs(sp.p.y), fabs(sp.p.z));
     sp.object = -1;
     sp.tri = -1;
     sp.front = 0;
@@ -219,7 +219,7 @@ VB_INLINE ShadePoint probe_case_point(__global const float *cs, VbMedium m)
     sp.material = 0;
     sp.key = 0;
     sp.medium = m;
-    sp.scale = cs[12];
+    sp.err = cs[12];
     sp.band = -1;
     return sp;
 }
@@ -266,7 +266,7 @@ VB_INLINE uint probe_beside_host(const DevScene *sc, const ShadePoint *sp, float
 
 /* The shadow cone test against brute force. cases, 16 floats each: a point (xyz, its
  * object or -1), its normal on the viewer's side (xyz, 1 when that is its triangle's own
- * normal), a light (centre xyz, radius), the point's triangle's scale, its triangle -> out:
+ * normal), a light (centre xyz, radius), the point's ray offset, its triangle -> out:
  * bits 0-1 what light_cone_objects says (0: the grid, 1: clear, 2: a set of triangles
  * alone; 3: the point is inside the light, no test), bit 2 set where the set (or clear
  * cone) has big objects or texture parts whose bounds each feeler tests, bit 3 where some feeler
@@ -385,7 +385,7 @@ VB_INLINE float3 probe_transmittance_plain(const DevScene *sc, const ObjectSet *
         if (vb_max3(trans) < 1e-7f) return (float3)(0.0f);
         state = c.after;
         left -= seg;
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc->tris, h.tri));
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, tri_point_error(sc->tris, h, ng));
     }
     return (float3)(0.0f);
 }
@@ -562,8 +562,8 @@ __kernel void probe_tree_exits(SCENE_KERNEL_ARGS __global const float *ray, int 
 
 #ifdef VBCL_HAS_TRANSPARENCY
 /* The object sets of ray-tree rays (ray_objects) against the grid. cases as
- * probe_cone_brute's (a point, its object, its normal on the viewer's side, its triangle's
- * scale and index), and in [14] the host of the viewer's side, in [15] the host of the other
+ * probe_cone_brute's (a point, its object, its normal on the viewer's side, its ray
+ * offset and triangle), and in [14] the host of the viewer's side, in [15] the host of the other
  * side (-1: none) -> out: bits 0-15 how many of nrays rays from the point (directions
  * uniform over the sphere, each from the side it leaves to, but every fourth from the other
  * side, as a reflection about a smooth normal can turn back in) follow a different way
@@ -583,7 +583,7 @@ __kernel void probe_ray_objects(SCENE_KERNEL_ARGS __global const float *cases, i
     __global const float *cs = cases + 16 * i;
     float3 p = vload3(0, cs), n = normalize(vload3(0, cs + 4));
     int tri = (int)cs[13];
-    float scale = cs[12];
+    float err = cs[12];
     float3 a = tri_vertex(sc.tris, tri, 0).xyz;
     float3 nt = cross(tri_vertex(sc.tris, tri, 1).xyz - a, tri_vertex(sc.tris, tri, 2).xyz - a);
     uint tag = tri_tag(sc.tris, tri);
@@ -600,7 +600,7 @@ __kernel void probe_ray_objects(SCENE_KERNEL_ARGS __global const float *cases, i
         float3 w = (float3)(rr * cos(phi), rr * sin(phi), z);
         float s = dot(w, n) >= 0.0f ? 1.0f : -1.0f;
         if ((k & 3) == 3) s = -s; /* turned back */
-        float3 o = ray_offset_origin(p, s * n, scale);
+        float3 o = ray_offset_origin(p, s * n, err);
         VbMedium m0 = {s > 0.0f ? (int)cs[14] : (int)cs[15], 0u};
         ObjectSet os;
         float reach = ray_objects(&sc, o, w, tri, m0.host, &os);
@@ -876,7 +876,7 @@ __kernel void probe_feeler_walk(SCENE_KERNEL_ARGS __global const VbRay *feelers,
         last = -1.0f;
         state = c.after;
         left -= seg;
-        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, TRI_SCALE(sc.tris, h.tri));
+        o = ray_offset_origin(p, dot(ng, dir) > 0.0f ? ng : -ng, tri_point_error(sc.tris, h, ng));
     }
     if (!walk) {
         VbHit h = scene_trace_closest(&sc, o, dir, left, &tc);

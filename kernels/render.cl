@@ -88,7 +88,7 @@ VB_INLINE ShadePoint shade_point_make(const DevScene *sc, float3 dir, VbHit h, u
     sp.material = material;
     sp.key = key;
     sp.medium = medium;
-    sp.scale = TRI_SCALE(sc->tris, h.tri);
+    sp.err = tri_point_error(sc->tris, h, ng);
     uint tag = tri_tag(sc->tris, h.tri);
     /* a texture element's surface is not its host's: the host's shape says nothing of it */
     sp.object = (tag & VBCL_TAG_TEXTURE) ? -1 : (int)(tag & ~VBCL_TAG_FLAGS);
@@ -360,7 +360,7 @@ __kernel void tree_trace_secondary(FRAME_KERNEL_ARGS TREE_SPLIT_ARG)
         if (bands) {
             VbSplit s = splits[i].s[k];
             sp.p = vload3(0, s.p);
-            sp.scale = s.p[3];
+            sp.err = s.p[3];
             sp.ng = vload3(0, s.ng);
             sp.ns = vload3(0, s.ns);
             sp.tri = -1; /* not recorded: its rays leave nothing out (ray_objects) */

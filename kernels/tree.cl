@@ -96,9 +96,9 @@ VB_INLINE void tree_push_bands(const DevScene *sc, TreeRay *stack, int *n, const
         cnt->tir += (uint)s.tir;
         cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
         if (s.T > 0.0f)
-            tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), sp->tri,
-                      s.transmitted, wg * bw * (s.T * medium_band_transmit(sc, c->mat_after, b)),
-                      c->after, depth, vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
+            tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->err), sp->tri, s.transmitted,
+                      wg * bw * (s.T * medium_band_transmit(sc, c->mat_after, b)), c->after, depth,
+                      vb_hash(tkey + (uint)b), sc->f, cnt, 1, b);
     }
 }
 
@@ -109,7 +109,7 @@ VB_INLINE int tree_record_split(__global VbSplitSet *rec, const ShadePoint *sp, 
 {
     if (!rec || rec->count >= VBCL_SPLIT_SLOTS) return 0;
     __global VbSplit *s = rec->s + rec->count++;
-    vstore4((float4)(sp->p, sp->scale), 0, s->p);
+    vstore4((float4)(sp->p, sp->err), 0, s->p);
     vstore4((float4)(sp->ng, 0.0f), 0, s->ng);
     vstore4((float4)(sp->ns, 0.0f), 0, s->ns);
     vstore4((float4)(dir, 0.0f), 0, s->dir);
@@ -149,7 +149,7 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
                                              medium_eta(sc, c->mat_after, b), TREE_THESIS(sc));
                 wr += vb_gload3(sc->texels + sc->f->band_weights + 4 * b) * s.R;
             }
-            tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s0.reflected,
+            tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->err), sp->tri, s0.reflected,
                       wg * wr, before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
             uint tkey = vb_hash(2u * sp->key + 2u);
             if (!tree_record_split(rec, sp, dir, c, wg, depth, tkey))
@@ -157,7 +157,7 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
             return;
         }
         cnt->tir += (uint)s0.tir;
-        tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s0.reflected,
+        tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->err), sp->tri, s0.reflected,
                   wg * s0.R, before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, -1);
         return;
     }
@@ -172,10 +172,10 @@ VB_INLINE void tree_spawn(const DevScene *sc, TreeRay *stack, int *n, const Shad
     cnt->tir += (uint)s.tir;
     cnt->interfaces++;
     cnt->energy_errors += fabs(s.R + s.T - 1.0f) > 1e-5f;
-    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->scale), sp->tri, s.reflected, wg * s.R,
+    tree_push(stack, n, ray_offset_origin(sp->p, sp->ng, sp->err), sp->tri, s.reflected, wg * s.R,
               before, depth, vb_hash(2u * sp->key + 1u), sc->f, cnt, 0, band);
     if (s.T > 0.0f)
-        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->scale), sp->tri, s.transmitted,
+        tree_push(stack, n, ray_offset_origin(sp->p, -sp->ng, sp->err), sp->tri, s.transmitted,
                   wg * (s.T * tin), c->after, depth, vb_hash(2u * sp->key + 2u), sc->f, cnt, 1,
                   band);
 }

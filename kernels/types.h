@@ -400,7 +400,7 @@ typedef struct VbFrame {
  * traced inline. Device data only: the host sizes the buffer. */
 #define VBCL_SPLIT_SLOTS 2
 typedef struct VbSplit {
-    float p[4];      /* the shading point; [3]: its triangle's scale (ray offsets) */
+    float p[4];      /* the shading point; [3]: its ray offset (tri_point_error) */
     float ng[4];     /* unit geometric normal on the incoming side */
     float ns[4];     /* unit shading normal, same side */
     float dir[4];    /* incoming direction */

@@ -43,7 +43,7 @@ for scene in scenes/*.json scenes/thesis/*.json; do
         echo "$name: identical"
     else
         differ=$((differ + 1))
-        echo "$name: DIFFERENT: $(grep -E 'Mean error|Max error|pixels' "$tmp/idiff.log" | tr '\n' ' ')"
+        echo "$name: DIFFERENT: $(grep -E 'Mean error|RMS error|Max error|pixels' "$tmp/idiff.log" | tr '\n' ' ')"
     fi
     rm -f "$tmp"/old*.exr "$tmp"/new*.exr
 done

@@ -9,6 +9,7 @@
 
 #include "harness.h"
 #include "render.h"
+#include "offset.h"
 #include "fixture.h"
 #include "testutil.h"
 
@@ -631,10 +632,11 @@ static void cone_cases(const Fixture *fx, float *cases, int ncases, unsigned see
         float side = frand(&seed) < 0.5f ? 1.0f : -1.0f;
         vec3 n = v3_scale(v3_norm(v3_cross(e1, e2)), side);
         uint32_t tag = fx->s.tri_tag[t];
-        float scale = 0.0f;
-        vec3 vs[3] = {a, b, d};
-        for (int k = 0; k < 3; k++)
-            scale = fmaxf(scale, fmaxf(fabsf(vs[k].x), fmaxf(fabsf(vs[k].y), fabsf(vs[k].z))));
+        /* the bound of p's distance from the plane (offset.h), as for a point interpolated
+         * with weights (1, u, v) on a and the edges: 3 terms, each rounded */
+        float err = vb_offset_error(n.x, n.y, n.z, vb_offset_sum(1.0f, u, v, a.x, e1.x, e2.x),
+                                    vb_offset_sum(1.0f, u, v, a.y, e1.y, e2.y),
+                                    vb_offset_sum(1.0f, u, v, a.z, e1.z, e2.z));
         float pv[16] = {
             p.x,
             p.y,
@@ -648,7 +650,7 @@ static void cone_cases(const Fixture *fx, float *cases, int ncases, unsigned see
             8.0f * frand(&seed) + 2.0f,
             16.0f * frand(&seed) - 8.0f,
             frand(&seed) * frand(&seed),
-            scale,
+            err,
             (float)t,
             ob->is_host && (tex ? side > 0.0f : side < 0.0f) ? (float)(ob - fx->s.objects) : -1.0f,
             0};

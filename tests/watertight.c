@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "offset.h"
 #include "render.h"
 #include "scene.h"
 
@@ -75,22 +76,6 @@ static D3 rng_direction(uint64_t *s)
         double l2 = d3_dot(v, v);
         if (l2 > 1e-6 && l2 <= 1.0) return d3_mul(v, 1.0 / sqrt(l2));
     }
-}
-
-/* ray_offset_origin of kernels/geometry.cl, ported to the host operation by operation
- * (convert_int rounds toward zero, as a C cast does; no contraction on either side):
- * the per-component rule, then the floor of about 16 ulps of the triangle's scale. */
-static float offset_component(float p, float n)
-{
-    const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-    int of_i = (int)(int_scale * n);
-    int32_t bits;
-    memcpy(&bits, &p, sizeof bits);
-    bits += p < 0.0f ? -of_i : of_i;
-    float p_i;
-    memcpy(&p_i, &bits, sizeof p_i);
-    float p_f = p + float_scale * n;
-    return fabsf(p) < origin ? p_f : p_i;
 }
 
 /* The triangle's unit normal as tri_normal computes it, in float. */
@@ -232,7 +217,16 @@ typedef struct Adjacency {
     uint32_t *weld;  /* per vertex: the lowest index of a vertex at the same position */
     uint32_t *start; /* nverts + 1, by welded index */
     uint32_t *tris;
+    uint32_t *part; /* per triangle: its connected piece (a texture's element), as a welded
+                       vertex index */
 } Adjacency;
+
+/* The root of welded vertex v in the union-find forest up (path halving). */
+static uint32_t part_root(uint32_t *up, uint32_t v)
+{
+    while (up[v] != v) v = up[v] = up[up[v]];
+    return v;
+}
 
 static const Mesh *weld_mesh; /* for the qsort comparison */
 
@@ -269,6 +263,21 @@ static int adjacency_build(Adjacency *a, const Mesh *m)
     for (size_t v = 0; v < nv; v++) a->start[v + 1] += a->start[v];
     memcpy(fill, a->start, sizeof *fill * (nv + 1));
     for (uint32_t i = 0; i < 3 * m->ntris; i++) a->tris[fill[a->weld[m->tris[i]]]++] = i / 3;
+    /* pieces: the triangles joined through shared (welded) vertices */
+    a->part = malloc(sizeof *a->part * ((size_t)m->ntris + 1));
+    if (!a->part) {
+        free(order);
+        free(fill);
+        return -1;
+    }
+    for (size_t v = 0; v < nv; v++) fill[v] = (uint32_t)v;
+    for (uint32_t t = 0; t < m->ntris; t++)
+        for (int k = 1; k < 3; k++) {
+            uint32_t r0 = part_root(fill, a->weld[m->tris[3 * t]]),
+                     rk = part_root(fill, a->weld[m->tris[3 * t + k]]);
+            fill[rk] = r0;
+        }
+    for (uint32_t t = 0; t < m->ntris; t++) a->part[t] = part_root(fill, a->weld[m->tris[3 * t]]);
     free(order);
     free(fill);
     return 0;
@@ -278,6 +287,26 @@ static int tri_has_vertex(const Mesh *m, const Adjacency *adj, uint32_t t, uint3
 {
     for (int k = 0; k < 3; k++)
         if (adj->weld[m->tris[3 * t + k]] == v) return 1;
+    return 0;
+}
+
+/* Whether the offset from p (on triangle src) to o crosses the plane of a triangle that
+ * shares a corner with src, or p or o lies within p's rounding (8 units of its largest
+ * coordinate) of such a plane: p on the edge the two share, or the origin on the plane. */
+static int offset_crosses_neighbour(const Mesh *m, const Adjacency *adj, const D3 *normals, int src,
+                                    D3 p, D3 o)
+{
+    double tol = 8.0 * FLT_EPSILON * d3_maxabs(p);
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = adj->weld[m->tris[3 * (uint32_t)src + k]];
+        for (uint32_t i = adj->start[v]; i < adj->start[v + 1]; i++) {
+            uint32_t t = adj->tris[i];
+            if ((int)t == src) continue;
+            D3 a = d3_of(m->verts[m->tris[3 * t]]);
+            double sp = d3_dot(d3_sub(p, a), normals[t]), so = d3_dot(d3_sub(o, a), normals[t]);
+            if ((sp > 0.0) != (so > 0.0) || fabs(so) <= tol || fabs(sp) <= tol) return 1;
+        }
+    }
     return 0;
 }
 
@@ -334,43 +363,73 @@ static int crossing_direction(const D3 *nrm, int n, double sign, uint64_t *rng, 
 }
 
 const WtShape watertight_shapes[] = {
-    {"icosahedron", "\"shape\": \"sphere\", \"level\": 0", 1},
-    {"sphere-2", "\"shape\": \"sphere\", \"level\": 2", 1},
-    {"sphere-4", "\"shape\": \"sphere\", \"level\": 4", 1},
+    {"icosahedron", "\"shape\": \"sphere\", \"level\": 0", 1, 1.6},
+    {"sphere-2", "\"shape\": \"sphere\", \"level\": 2", 1, 1.9},
+    {"sphere-4", "\"shape\": \"sphere\", \"level\": 4", 1, 2},
     {"vase",
      "\"shape\": \"revolution\", \"segments\": 24, \"profile\": [[0, -1.1], [0.45, "
      "-1.1], [0.75, -0.75], [0.85, -0.25], [0.62, 0.35], [0.34, 0.75], [0.3, 0.95], "
      "[0.42, 1.15]]",
-     0},
+     0, 0.6},
     {"spindle",
      "\"shape\": \"revolution\", \"segments\": 12, \"profile\": [[0, -1], [1, 0], "
      "[0, 1]]",
-     1},
-    {"prism", "\"shape\": \"prism\", \"depth\": 1.5", 1},
-    {"sliver-prism", "\"shape\": \"prism\", \"points\": [[-0.5, 0], [0.5, 0], [0, 0.01]]", 1},
-    {"box", "\"shape\": \"box\", \"size\": [1, 2, 3]", 1},
-    {"flat-box", "\"shape\": \"box\", \"size\": [1, 0.001, 1]", 1},
+     1, 2},
+    {"prism", "\"shape\": \"prism\", \"depth\": 1.5", 1, 0.87},
+    {"sliver-prism", "\"shape\": \"prism\", \"points\": [[-0.5, 0], [0.5, 0], [0, 0.01]]", 1, 0.01},
+    {"box", "\"shape\": \"box\", \"size\": [1, 2, 3]", 1, 1},
+    {"flat-box", "\"shape\": \"box\", \"size\": [1, 0.001, 1]", 1, 0.001},
 };
 const int watertight_nshapes = (int)(sizeof watertight_shapes / sizeof watertight_shapes[0]);
 
-void watertight_scene_json(const char *object, double scale, const double offset[3], char *out,
-                           size_t n)
+void watertight_scene_json(const char *object, double scale, const double offset[3],
+                           int look_origin, char *out, size_t n)
 {
+    double at[3] = {offset[0], offset[1], offset[2]};
+    if (look_origin) at[0] = at[1] = at[2] = 0.0;
     snprintf(out, n,
-             "{\"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"look_at\": [%.9g, %.9g, %.9g]},\n"
+             "{\"camera\": {\"eye\": [%.17g, %.17g, %.17g], \"look_at\": [%.17g, %.17g, %.17g]},\n"
              " \"materials\": {\"m\": {}},\n"
              " \"objects\": [{%s, \"material\": \"m\",\n"
-             "   \"transform\": {\"scale\": %.9g, \"rotate\": [17, 29, 41],"
-             " \"translate\": [%.9g, %.9g, %.9g]}}]}\n",
-             offset[0], offset[1], offset[2] + 10.0 * scale, offset[0], offset[1], offset[2],
-             object, scale, offset[0], offset[1], offset[2]);
+             "   \"transform\": {\"scale\": %.17g, \"rotate\": [17, 29, 41],"
+             " \"translate\": [%.17g, %.17g, %.17g]}}]}\n",
+             at[0], at[1], at[2] + 10.0 * scale, at[0], at[1], at[2], object, scale, offset[0],
+             offset[1], offset[2]);
+}
+
+void watertight_case(int k, WtCase *c)
+{
+    static const double scales[] = {1e-6, 1e-3, 1.0, 1e4, 1e6}, far[] = {1e3, 1e4, 1e5};
+    memset(c, 0, sizeof *c);
+    if (k < 10) {
+        int moved = k % 2;
+        c->scale = scales[k / 2];
+        c->offset[0] = moved * 50 * c->scale;
+        c->offset[1] = moved * -30 * c->scale;
+        c->offset[2] = moved * 40 * c->scale;
+        c->label = moved ? "moved" : "";
+    } else {
+        double d = far[(k - 10) % 3];
+        c->scale = 1.0;
+        c->offset[0] = 0.6 * d, c->offset[1] = -0.48 * d, c->offset[2] = 0.64 * d;
+        c->look_origin = 1;
+        c->label = d == 1e3 ? "1e3 away" : d == 1e4 ? "1e4 away" : "1e5 away";
+    }
+}
+
+int watertight_case_fits(const WtShape *sh, const WtCase *c)
+{
+    double far = 0.0;
+    for (int k = 0; k < 3; k++) far = fmax(far, fabs(c->offset[k]));
+    if (!c->look_origin) return 1; /* the scene's frame brings it to the origin at unit size */
+    return sh->thin * c->scale >= 64.0 * FLT_EPSILON * (far + 2.0 * c->scale);
 }
 
 /* Checks the aimed rays' hits; appends rays leaving the good hits to out, with the medium
  * they travel in and their source triangle. Returns the number of leaks. */
 static unsigned long long check_aimed(const Mesh *m, const D3 *normals, const VbRay *rays,
                                       const Aim *aim, const VbHit *hits, int n, uint64_t *rng,
-                                      VbRay *out, int *src, int *outside, int *nout)
+                                      VbRay *out, int *src, int *outside, D3 *from, int *nout)
 {
     unsigned long long leaks = 0;
     for (int i = 0; i < n; i++) {
@@ -400,16 +459,13 @@ static unsigned long long check_aimed(const Mesh *m, const D3 *normals, const Vb
         vec3 ng = tri_normal_f(m, t);
         float side = v3_dot(ng, v3((float)dir.x, (float)dir.y, (float)dir.z)) < 0.0f ? 1.0f : -1.0f;
         vec3 nf = v3_scale(ng, side);
-        vec3 q = v3(offset_component(p.x, nf.x), offset_component(p.y, nf.y),
-                    offset_component(p.z, nf.z));
-        float scale = 0.0f;
-        for (int k = 0; k < 3; k++) {
-            vec3 v = k == 0 ? a : k == 1 ? b : c;
-            scale = fmaxf(scale, fmaxf(fabsf(v.x), fmaxf(fabsf(v.y), fabsf(v.z))));
-        }
-        float need = scale * (1.0f / 1048576.0f);
-        vec3 dq = v3_sub(q, p);
-        if (!(dq.x * nf.x + dq.y * nf.y + dq.z * nf.z >= need)) q = v3_add(p, v3_scale(nf, need));
+        /* ray_offset_origin with tri_point_error (kernels/geometry.cl), from offset.h, the
+         * kernels' own arithmetic */
+        float err = vb_offset_error(ng.x, ng.y, ng.z, vb_offset_sum(w0, h->u, h->v, a.x, b.x, c.x),
+                                    vb_offset_sum(w0, h->u, h->v, a.y, b.y, c.y),
+                                    vb_offset_sum(w0, h->u, h->v, a.z, b.z, c.z));
+        vec3 q = v3(vb_offset_coord(p.x, nf.x, err), vb_offset_coord(p.y, nf.y, err),
+                    vb_offset_coord(p.z, nf.z, err));
         D3 org = d3(q.x, q.y, q.z);
         D3 hemi = rng_direction(rng);
         if (d3_dot(hemi, d3_of(nf)) < 0) hemi = d3_mul(hemi, -1);
@@ -417,6 +473,7 @@ static unsigned long long check_aimed(const Mesh *m, const D3 *normals, const Vb
         set_ray(&out[*nout + 1], org, hemi);
         src[*nout] = src[*nout + 1] = h->tri;
         outside[*nout] = outside[*nout + 1] = side > 0; /* leaving on the front: outside */
+        from[*nout] = from[*nout + 1] = d3_of(p);
         *nout += 2;
     }
     return leaks;
@@ -427,7 +484,7 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
 {
     Scene s;
     Tracer tr;
-    Adjacency adj = {NULL, NULL, NULL};
+    Adjacency adj = {NULL, NULL, NULL, NULL};
     int rc = -1, tracer_ok = 0;
     memset(&tr, 0, sizeof tr);
     if (scene_load(scene_path, &s, err, errlen)) return -1;
@@ -442,9 +499,10 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
     Aim *baim = malloc(sizeof *baim * WT_AIMED * WT_BATCH);
     int *src = malloc(sizeof *src * 2 * WT_AIMED * WT_BATCH),
         *outside = malloc(sizeof *outside * 2 * WT_AIMED * WT_BATCH);
+    D3 *from = malloc(sizeof *from * 2 * WT_AIMED * WT_BATCH);
     D3 *normals = malloc(sizeof *normals * ((size_t)m->ntris + 1));
     if (!rays || !brays || !orays || !hits || !bhits || !aim || !baim || !src || !outside ||
-        !normals || adjacency_build(&adj, m)) {
+        !from || !normals || adjacency_build(&adj, m)) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
@@ -519,12 +577,13 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
         done_targets += nb;
         if (tracer_trace(&tr, rays, n, hits, 0, err, errlen)) goto done;
         st->aimed += (unsigned long long)n;
-        st->leaks += check_aimed(m, normals, rays, aim, hits, n, &rng, orays, src, outside, &nout);
+        st->leaks +=
+            check_aimed(m, normals, rays, aim, hits, n, &rng, orays, src, outside, from, &nout);
         if (nbrute) {
             if (tracer_trace(&tr, brays, nbrute, bhits, 1, err, errlen)) goto done;
             st->brute_aimed += (unsigned long long)nbrute;
-            st->brute_leaks +=
-                check_aimed(m, normals, brays, baim, bhits, nbrute, &rng, NULL, NULL, NULL, NULL);
+            st->brute_leaks += check_aimed(m, normals, brays, baim, bhits, nbrute, &rng, NULL, NULL,
+                                           NULL, NULL, NULL);
         }
         /* rays leaving the hit points */
         if (tracer_trace(&tr, orays, nout, hits, 0, err, errlen)) goto done;
@@ -532,8 +591,20 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
         for (int i = 0; i < nout; i++) {
             const VbHit *h = &hits[i];
             if (h->tri < 0) continue;
+            /* another piece (a texture's elements may overlap): inside and outside are each
+             * piece's own, and this test knows nothing of the union */
+            if (adj.part[h->tri] != adj.part[src[i]]) {
+                st->other_piece++;
+                continue;
+            }
             D3 dir = d3(orays[i].dir[0], orays[i].dir[1], orays[i].dir[2]);
             double facing = d3_dot(dir, normals[h->tri]);
+            /* a ray along a triangle's plane to within its direction's rounding (the shear
+             * the test applies rounds it by as much) meets it or not as that rounding goes */
+            if (fabs(facing) <= 4.0 * FLT_EPSILON) {
+                st->grazing++;
+                continue;
+            }
             /* in the outside medium the first hit is a front face, inside a back face */
             int wrong = outside[i] ? facing > 1e-6 : facing < -1e-6;
             int suspect =
@@ -554,6 +625,17 @@ int watertight_run(VbDevice *d, const char *scene_path, int convex, long targets
                 st->escapes++;
             else
                 st->self_hits++;
+            /* explained: the offset from the hit point to the origin crosses the plane of a
+             * triangle around the start triangle's corners, or the hit point or the origin
+             * lies within the point's rounding of one (8 units of its largest coordinate):
+             * the hit point on an edge, and the offset, carried the origin past a
+             * neighbour's face */
+            if (escaped && !offset_crosses_neighbour(m, &adj, normals, src[i], from[i], o)) {
+                st->escapes_unexplained++;
+                if (getenv("VBCL_WT_VERBOSE"))
+                    fprintf(stderr, "      unexplained: triangle %d from %d, offset %.3g\n", h->tri,
+                            src[i], sqrt(d3_dot(d3_sub(o, from[i]), d3_sub(o, from[i]))));
+            }
             if (getenv("VBCL_WT_VERBOSE"))
                 fprintf(stderr,
                         "      %s: %s ray %s from triangle %d: hit triangle %d at t %.3g (size "
@@ -575,10 +657,12 @@ done:
     free(baim);
     free(src);
     free(outside);
+    free(from);
     free(normals);
     free(adj.weld);
     free(adj.start);
     free(adj.tris);
+    free(adj.part);
     scene_free(&s);
     return rc;
 }

@@ -178,8 +178,9 @@ void scene_frame_pick(Scene *s, const double eye[3], const double look_at[3])
     s->frame_scale = 1.0f;
     if (d < SCENE_FRAME_MIN_VIEW || d > SCENE_FRAME_MAX_VIEW) /* 2^-64 .. 2^64: finite */
         s->frame_scale = (float)exp2(fmin(fmax(-round(log2(d)), -64.0), 64.0));
+    double step = exp2(ceil(log2(d))); /* d > 0: look_at differs from eye */
     for (int k = 0; k < 3; k++)
-        s->frame_origin[k] = far > SCENE_FRAME_FAR_VIEWS * d ? look_at[k] : 0;
+        s->frame_origin[k] = far > SCENE_FRAME_FAR_VIEWS * d ? step * round(look_at[k] / step) : 0;
     s->eye = scene_frame_point(s, eye);
     s->look_at = scene_frame_point(s, look_at);
 }
@@ -430,7 +431,10 @@ static int load_lights(Ctx *c, const cJSON *j, Scene *s)
             return scene_fail(c, p, "give exactly one of \"flux\" and \"intensity\"");
         /* intensity I = flux / 4 pi; a sphere of uniform radiance L has I = L pi r^2 */
         double I = intensity > 0 ? intensity : flux / (4.0 * M_PI);
-        double scale = radius > 0 ? I / (M_PI * (double)radius * radius) : I;
+        /* a point light's intensity falls off as 1 / d^2 in the frame's lengths: scaled by
+         * the frame's scale squared, it lights a point as it does in the file's units */
+        double fs = s->frame_scale;
+        double scale = radius > 0 ? I / (M_PI * (double)radius * radius) : I * fs * fs;
         if (!isfinite(centre.x + centre.y + centre.z) || !isfinite(radius * s->frame_scale))
             return scene_fail(c, p, "the light lies beyond a float's range in the camera's frame");
         VbLight *l = &s->lights[i];

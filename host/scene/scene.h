@@ -194,12 +194,15 @@ const char *scene_display_name(const char *path);
 
 /* Picks s->frame_origin and frame_scale from the camera as written (eye and look_at, in
  * double): the scale 2^-round(log2 d) of the viewing distance d when d <
- * SCENE_FRAME_MIN_VIEW or d > SCENE_FRAME_MAX_VIEW, else 1; the origin look_at when it lies
- * more than SCENE_FRAME_FAR_VIEWS viewing distances from (0, 0, 0), else (0, 0, 0). Then
+ * SCENE_FRAME_MIN_VIEW or d > SCENE_FRAME_MAX_VIEW, else 1; the origin look_at, each
+ * coordinate rounded to a multiple of 2^ceil(log2 d), when look_at lies more than
+ * SCENE_FRAME_FAR_VIEWS viewing distances from (0, 0, 0), else (0, 0, 0). (The rounding
+ * keeps the frame's coordinates within a viewing distance of look_at, and makes a scene
+ * moved by a multiple of that power of two the same scene in the frame, bit for bit.) Then
  * puts the camera in that frame. */
 #define SCENE_FRAME_MIN_VIEW  (1.0 / 16.0)
 #define SCENE_FRAME_MAX_VIEW  1024.0
-#define SCENE_FRAME_FAR_VIEWS 64.0
+#define SCENE_FRAME_FAR_VIEWS 2.0
 void scene_frame_pick(Scene *s, const double eye[3], const double look_at[3]);
 
 /* Point p of the scene file (in double, as written) in s's frame. */

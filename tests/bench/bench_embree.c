@@ -13,6 +13,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "offset.h"
+
 struct BenchEmbree {
     RTCDevice device;
     RTCScene scene;
@@ -124,46 +126,36 @@ static float dot3(const float a[3], const float b[3])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* kernels/geometry.cl ray_offset_origin on the host: p moved off its surface along n (unit,
- * on the side to leave toward) by integer ulps far from the origin, by a float step near
- * it, and at least by scale / 2^20 (Wächter & Binder 2019). */
-static void offset_origin(const float p[3], const float n[3], float scale, float q[3])
+/* kernels/geometry.cl ray_offset_origin on the host, with offset.h's arithmetic: p moved
+ * off its surface along n (unit, on the side to leave toward) by err, the bound of p's
+ * distance from the triangle's plane, and one float further. */
+static void offset_origin(const float p[3], const float n[3], float err, float q[3])
 {
-    for (int k = 0; k < 3; k++) {
-        int32_t of = (int32_t)(256.0f * n[k]), bits;
-        memcpy(&bits, &p[k], sizeof bits);
-        bits += p[k] < 0.0f ? -of : of;
-        float pi;
-        memcpy(&pi, &bits, sizeof pi);
-        q[k] = fabsf(p[k]) < 1.0f / 32.0f ? p[k] + (1.0f / 65536.0f) * n[k] : pi;
-    }
-    float need = scale * (1.0f / 1048576.0f), dq[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-    if (dot3(dq, n) >= need) return;
-    for (int k = 0; k < 3; k++) q[k] = p[k] + need * n[k];
+    for (int k = 0; k < 3; k++) q[k] = vb_offset_coord(p[k], n[k], err);
 }
 
 /* The hit point of a triangle at barycentrics (u, v), its unit normal turned along d, and
- * its largest vertex coordinate, as the kernels compute them (tri_point, tri_normal,
- * TRI_SCALE). */
+ * the bound of the point's distance from the plane, as the kernels compute them (tri_point,
+ * tri_normal, tri_point_error). */
 static void hit_geometry(const Mesh *m, unsigned tri, float u, float v, const float d[3],
-                         float p[3], float ng[3], float *scale)
+                         float p[3], float ng[3], float *err)
 {
     const vec3 *a = &m->verts[m->tris[3 * tri]], *b = &m->verts[m->tris[3 * tri + 1]],
                *c = &m->verts[m->tris[3 * tri + 2]];
     float va[3] = {a->x, a->y, a->z}, vb[3] = {b->x, b->y, b->z}, vc[3] = {c->x, c->y, c->z};
-    float e1[3], e2[3], s = 0.0f;
+    float e1[3], e2[3], s[3], w0 = 1.0f - u - v;
     for (int k = 0; k < 3; k++) {
-        p[k] = (1.0f - u - v) * va[k] + u * vb[k] + v * vc[k];
+        p[k] = w0 * va[k] + u * vb[k] + v * vc[k];
         e1[k] = vb[k] - va[k];
         e2[k] = vc[k] - va[k];
-        s = fmaxf(s, fmaxf(fabsf(va[k]), fmaxf(fabsf(vb[k]), fabsf(vc[k]))));
+        s[k] = vb_offset_sum(w0, u, v, va[k], vb[k], vc[k]);
     }
     ng[0] = e1[1] * e2[2] - e1[2] * e2[1];
     ng[1] = e1[2] * e2[0] - e1[0] * e2[2];
     ng[2] = e1[0] * e2[1] - e1[1] * e2[0];
     float len = sqrtf(dot3(ng, ng)), side = dot3(ng, d) > 0.0f ? 1.0f : -1.0f;
     for (int k = 0; k < 3; k++) ng[k] *= side / len;
-    *scale = s;
+    *err = vb_offset_error(ng[0], ng[1], ng[2], s[0], s[1], s[2]);
 }
 
 /* EMBREE_WALK for one ray: up to `steps` closest hits from crossing to crossing. */
@@ -177,13 +169,13 @@ static float walk_one(const BenchEmbree *e, struct RTCIntersectContext *ctx, con
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(e->scene, ctx, &rh);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1.0f;
-        float p[3], ng[3], scale;
-        hit_geometry(e->mesh, rh.hit.primID, rh.hit.u, rh.hit.v, r->dir, p, ng, &scale);
+        float p[3], ng[3], err;
+        hit_geometry(e->mesh, rh.hit.primID, rh.hit.u, rh.hit.v, r->dir, p, ng, &err);
         float from_org[3] = {p[0] - r->org[0], p[1] - r->org[1], p[2] - r->org[2]};
         float from_o[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
         end = dot3(from_org, r->dir);
         left -= fmaxf(0.0f, dot3(from_o, r->dir));
-        offset_origin(p, ng, scale, o);
+        offset_origin(p, ng, err, o);
     }
     return end;
 }
