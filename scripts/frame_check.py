@@ -19,7 +19,7 @@ unit scene's (measured, not asserted: at these sizes it is mostly noise; docs/ar
 
 usage: scripts/frame_check.py --vbcl build/vbcl [--only REGEX] [--out DIR] [--stress]
   --stress   more scales and positions (every decade 1e-6 .. 1e6, moves of 1e3 .. 1e5 along
-             every axis, a diagonal and an uneven one) on every scene, 4 x 4 samples per pixel
+             every axis, a diagonal and an uneven one) on every scene, 5 x 5 samples per pixel
 """
 import argparse
 import copy
@@ -41,14 +41,16 @@ COUNTERS = [("rays", "primary"), ("rays", "shadow"), ("rays", "total"),
             ("ray_tree", "pass_through"), ("ray_tree", "interfaces"), ("ray_tree", "splits"),
             ("ray_tree", "band_rays")]
 SCENES = "tests/scenes/frame"
-# Every pixel is the mean of 2 x 2 samples (4 x 4 in --stress), as in a user's anti-aliased
+# Every pixel is the mean of 2 x 2 samples (5 x 5 in --stress), as in a user's anti-aliased
 # render: a scale that is no power of two or a move by an uneven amount changes the scene's
 # floats in their last place, and a sample on a knife edge (a silhouette, a feeler grazing an
 # edge, a path at the critical angle) goes the other way; alone, it moves its pixel by the
-# whole contrast of that edge (the glass sphere's unit render has a value that moves by
-# 0.057 when the scene moves by 0.3 along x, in the build before the offsets from the error
-# bound as in this one; the prism's thin line 0.57 at 144 x 96).
-SAMPLES = {False: ["--ssaa", "2"], True: ["--ssaa", "4"]}
+# whole contrast of that edge over the samples (the glass sphere's unit render has a value
+# that moves by 0.057 when the scene moves by 0.3 along x; the prism's thin line 0.57 at
+# 144 x 96). With 25 samples one such sample moves a pixel by at most 0.044 on an edge of
+# contrast up to 1.1 (the contact scene's brightest, 0.23 against 1.10), within DIFF_MAX; with
+# 16 it moved one by 0.056 in the contact scene moved by UNEVEN.
+SAMPLES = {False: ["--ssaa", "2"], True: ["--ssaa", "5"]}
 
 # The cases of make test: (name, scene, scale, move).
 UNEVEN = (12345.678, -54321.123, 77777.7)
